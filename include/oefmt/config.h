@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Parameters of the core. Every field is documented once more in config/default.yaml and the README.
+#pragma once
+
+#include "oefmt/fft.h"
+
+namespace oefmt {
+
+/// Parameters of the spectral pair registration (section 2 of the algorithm spec).
+struct RegistrationConfig {
+  int size = 512;                         ///< working image size N (even, >= 64) [px]
+  double taper_fraction = 0.12;           ///< apodization taper width as a fraction of N
+  double logpolar_radius_fraction = 0.55; ///< largest log-polar radius as a fraction of N
+  double polar_radius_fraction = 0.75;    ///< largest radius of the translation polar unwrap / N
+  int block_radius = 2;                   ///< r: rows fused on each side of the energy peak
+  double energy_smoothing_sigma = 1.0;    ///< Gaussian smoothing of energy vectors [bins], 0 = off
+  bool resolve_half_turn = true;          ///< tell theta from theta + 180 deg by the shift peak
+  double min_texture = 1e-3;              ///< grey std below which a frame counts as textureless
+  double min_confidence = 0.15;           ///< results below this confidence are flagged low
+  FftPlanning fft_planning = FftPlanning::kMeasure;  ///< FFTW planning effort (once per size)
+
+  /// Throws InputError naming the first invalid field.
+  void validate() const;
+};
+
+}  // namespace oefmt

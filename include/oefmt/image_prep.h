@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Image preparation: any camera image -> grey float, centre-cropped square of N x N pixels.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace oefmt {
+
+/// Order of the colour channels of a 3- or 4-channel image.
+enum class ChannelOrder { kBgr, kRgb };
+
+/// Pinhole intrinsics in pixels of the image they belong to.
+struct Intrinsics {
+  double fx = 0.0;
+  double fy = 0.0;
+  double cx = 0.0;
+  double cy = 0.0;
+  int width = 0;
+  int height = 0;
+  bool valid() const { return fx > 0.0 && fy > 0.0 && width > 0 && height > 0; }
+};
+
+/// A frame ready for spectral analysis, with the figures the registration needs to judge it.
+struct PreparedImage {
+  cv::Mat1f grey;          ///< size x size, intensities in [0, 1] for integer inputs
+  int invalid_pixels = 0;  ///< NaN/inf pixels of the input, replaced by the mean of the valid ones
+  double texture = 0.0;    ///< standard deviation of grey (0 for constant or black frames)
+};
+
+/// Converts any 1/3/4-channel 8-bit, 16-bit, 32-bit or 64-bit float image to single-channel float.
+/// Integer types are scaled to [0, 1]; float types are kept as they are.
+/// Throws InputError for an empty image or an unsupported pixel type (the message names it).
+cv::Mat1f toGreyFloat(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr);
+
+/// Centre-crops grey to a min(W, H) square and resizes it to size x size (area interpolation when
+/// shrinking, bilinear when growing). Non-finite pixels are replaced and counted.
+/// Throws InputError when size is odd or < 64, or the image is empty.
+PreparedImage prepareImage(const cv::Mat& image, int size,
+                           ChannelOrder order = ChannelOrder::kBgr);
+
+/// Intrinsics of the prepared size x size image made from an image of intrinsics.width x height.
+Intrinsics scaleIntrinsics(const Intrinsics& intrinsics, int size);
+
+}  // namespace oefmt

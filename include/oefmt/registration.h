@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Spectral registration of an image pair: rotation, zoom, translation and their energy vectors.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "oefmt/config.h"
+#include "oefmt/spectra.h"
+
+namespace oefmt {
+
+enum class RegistrationMethod {
+  kEnergyVectors,  ///< o-eFMT: Gaussian-fused zoom and translation energy vectors
+  kClassic,        ///< Reddy-Chatterji FMT: single peaks only, no energy vectors
+};
+
+enum class RegistrationStatus {
+  kOk,             ///< sharp peaks, usable
+  kLowConfidence,  ///< computed, but the peaks are weak (little overlap, blur, noise)
+  kTextureless,    ///< a frame is constant, black or saturated: nothing was estimated
+};
+const char* toString(RegistrationStatus status);
+
+/// The registration of an older frame A to a newer frame B.
+/// Axes: x right, y down (image). Angles: atan2(dy, dx) in these axes.
+struct PairRegistration {
+  RegistrationStatus status = RegistrationStatus::kTextureless;
+  double rotation = 0.0;     ///< theta [rad]: B is A rotated counter-clockwise on screen, (-pi, pi]
+  double zoom = 1.0;         ///< s: B looks s times larger than A
+  cv::Point2d translation;   ///< d [px]: shift of B's content after A is rotated+zoomed onto B
+  double direction = 0.0;    ///< phi = atan2(d.y, d.x) [rad]
+  double shift = 0.0;        ///< rho = |d| [px], the dominant depth's shift
+  double rotation_sigma = 0.0;   ///< [rad]
+  double log_zoom_sigma = 0.0;   ///< sigma of ln(s)
+  double direction_sigma = 0.0;  ///< [rad]
+  double shift_sigma = 0.0;      ///< [px]
+  std::vector<float> zoom_energy;         ///< S: bin j <-> ln(s) = -(j - N/2) ln(b); empty in classic
+  std::vector<float> translation_energy;  ///< T: bin j <-> shift j * polarRadiusStep(); empty in classic
+  double rotation_zoom_peak = 0.0;  ///< height of the rotation/zoom correlation peak (0..1)
+  double translation_peak = 0.0;    ///< height of the translation correlation peak (0..1)
+  double confidence = 0.0;          ///< 0 (unusable) .. 1, from both peak-to-sidelobe ratios
+  bool half_turn = false;           ///< the 180-degree alternative won
+
+  bool usable() const { return status == RegistrationStatus::kOk; }
+};
+
+/// Correlation surfaces of the last registration, for diagnostics and plots.
+struct RegistrationSurfaces {
+  cv::Mat1f rotation_zoom;      ///< rows: rotation, columns: log-zoom (centred)
+  cv::Mat1f translation;        ///< centred Cartesian translation surface
+  cv::Mat1f translation_polar;  ///< rows: direction, columns: radius (energy-vector method only)
+};
+
+/// Registers frame pairs. Holds per-thread scratch buffers, so use one Registrar per thread;
+/// several Registrars can share one SpectralContext (FFT plans and tables).
+class Registrar {
+ public:
+  explicit Registrar(const RegistrationConfig& config);
+  explicit Registrar(std::shared_ptr<const SpectralContext> context);
+
+  /// Spectra of a camera image of any size and supported type (see prepareImage).
+  FrameSpectra analyse(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr);
+  /// Spectra of an already prepared N x N image.
+  FrameSpectra analyse(const PreparedImage& image);
+
+  /// Registers older -> newer. Throws InputError if a frame is empty or the sizes differ.
+  PairRegistration registerPair(const FrameSpectra& older, const FrameSpectra& newer,
+                                RegistrationMethod method = RegistrationMethod::kEnergyVectors,
+                                RegistrationSurfaces* surfaces = nullptr);
+
+  const SpectralContext& context() const { return *context_; }
+  std::shared_ptr<const SpectralContext> sharedContext() const { return context_; }
+  /// ln(b): change of ln(zoom) per zoom-energy bin.
+  double logZoomPerBin() const;
+  /// Pixels of shift per translation-energy bin.
+  double shiftPerBin() const { return context_->polarRadiusStep(); }
+
+ private:
+  // Each returns the peak-to-sidelobe ratio of its correlation surface.
+  double registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
+                            RegistrationMethod method, PairRegistration& result);
+  double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
+                             RegistrationMethod method, PairRegistration& result);
+
+  std::shared_ptr<const SpectralContext> context_;
+  SpectraBuilder builder_;
+  // Scratch, reused across calls.
+  cv::Mat2f cross_power_, cross_power_turned_;
+  cv::Mat1f correlation_, surface_, surface_turned_, warped_, polar_;
+  cv::Mat2f warped_spectrum_;
+};
+
+}  // namespace oefmt

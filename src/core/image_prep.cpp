@@ -1,0 +1,115 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/image_prep.h"
+
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "oefmt/error.h"
+
+namespace oefmt {
+namespace {
+
+std::string describe(const cv::Mat& image) {
+  return cv::typeToString(image.type()) + " " + std::to_string(image.cols) + "x" +
+         std::to_string(image.rows);
+}
+
+// Replaces NaN/inf by the mean of the finite pixels; returns how many were replaced.
+int replaceNonFinite(cv::Mat1f& grey) {
+  int invalid = 0;
+  double sum = 0.0;
+  for (int r = 0; r < grey.rows; ++r) {
+    const float* row = grey[r];
+    for (int c = 0; c < grey.cols; ++c) {
+      if (std::isfinite(row[c])) {
+        sum += row[c];
+      } else {
+        ++invalid;
+      }
+    }
+  }
+  if (invalid == 0) return 0;
+  const long valid = static_cast<long>(grey.total()) - invalid;
+  const float fill = valid > 0 ? static_cast<float>(sum / static_cast<double>(valid)) : 0.0f;
+  for (int r = 0; r < grey.rows; ++r) {
+    float* row = grey[r];
+    for (int c = 0; c < grey.cols; ++c) {
+      if (!std::isfinite(row[c])) row[c] = fill;
+    }
+  }
+  return invalid;
+}
+
+}  // namespace
+
+cv::Mat1f toGreyFloat(const cv::Mat& image, ChannelOrder order) {
+  if (image.empty()) throw InputError("image is empty");
+  const int channels = image.channels();
+  if (channels != 1 && channels != 3 && channels != 4) {
+    throw InputError("unsupported image (" + describe(image) + "): expected 1, 3 or 4 channels");
+  }
+  double scale = 1.0;
+  switch (image.depth()) {
+    case CV_8U: scale = 1.0 / 255.0; break;
+    case CV_16U: scale = 1.0 / 65535.0; break;
+    case CV_32F:
+    case CV_64F: break;
+    default:
+      throw InputError("unsupported image (" + describe(image) +
+                       "): expected 8-bit, 16-bit unsigned or floating-point pixels");
+  }
+  cv::Mat source = image;
+  if (image.depth() == CV_64F) image.convertTo(source, CV_MAKETYPE(CV_32F, channels));
+  cv::Mat grey = source;
+  if (channels == 3) {
+    cv::cvtColor(source, grey, order == ChannelOrder::kBgr ? cv::COLOR_BGR2GRAY : cv::COLOR_RGB2GRAY);
+  } else if (channels == 4) {
+    cv::cvtColor(source, grey, order == ChannelOrder::kBgr ? cv::COLOR_BGRA2GRAY : cv::COLOR_RGBA2GRAY);
+  }
+  cv::Mat1f out;
+  grey.convertTo(out, CV_32F, scale);
+  return out;
+}
+
+PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
+  if (size < 64 || size % 2 != 0) {
+    throw InputError("working size must be even and >= 64, got " + std::to_string(size));
+  }
+  cv::Mat1f grey = toGreyFloat(image, order);
+  const int side = std::min(grey.cols, grey.rows);
+  const cv::Rect square((grey.cols - side) / 2, (grey.rows - side) / 2, side, side);
+  PreparedImage prepared;
+  cv::Mat1f cropped = grey(square).clone();
+  prepared.invalid_pixels = replaceNonFinite(cropped);
+  if (side == size) {
+    prepared.grey = cropped;
+  } else {
+    cv::resize(cropped, prepared.grey, cv::Size(size, size), 0.0, 0.0,
+               side > size ? cv::INTER_AREA : cv::INTER_LINEAR);
+  }
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(prepared.grey, mean, stddev);
+  prepared.texture = stddev[0];
+  return prepared;
+}
+
+Intrinsics scaleIntrinsics(const Intrinsics& in, int size) {
+  if (!in.valid()) throw InputError("intrinsics are invalid (fx, fy, width and height must be > 0)");
+  const int side = std::min(in.width, in.height);
+  const double k = static_cast<double>(size) / side;
+  const double x0 = (in.width - side) / 2;
+  const double y0 = (in.height - side) / 2;
+  Intrinsics out;
+  out.fx = in.fx * k;
+  out.fy = in.fy * k;
+  // Pixel centres sit at integer coordinates: the resize maps u to (u + 0.5) * k - 0.5.
+  out.cx = (in.cx - x0 + 0.5) * k - 0.5;
+  out.cy = (in.cy - y0 + 0.5) * k - 0.5;
+  out.width = size;
+  out.height = size;
+  return out;
+}
+
+}  // namespace oefmt

@@ -1,0 +1,204 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/registration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "oefmt/energy_vector.h"
+#include "oefmt/error.h"
+#include "oefmt/phase_correlation.h"
+
+namespace oefmt {
+namespace {
+
+// Peak-to-sidelobe ratios mapped to a 0..1 confidence: unrelated images give about 5 at
+// N = 512, a clean registration well above 20.
+constexpr double kPsrFloor = 7.0;
+constexpr double kPsrGood = 20.0;
+
+double wrapAngle(double a) {
+  a = std::fmod(a + CV_PI, 2.0 * CV_PI);
+  if (a <= 0.0) a += 2.0 * CV_PI;
+  return a - CV_PI;
+}
+
+// Gaussian widths (rows, columns) of the |.|^3 peak, for the single-peak (classic) method.
+cv::Point2d peakWidths(const cv::Mat1f& surface, const SurfacePeak& peak, bool cyclic_cols) {
+  constexpr int kRadius = 2;
+  float along_rows[2 * kRadius + 1];
+  float along_cols[2 * kRadius + 1];
+  for (int o = -kRadius; o <= kRadius; ++o) {
+    const int r = ((peak.row + o) % surface.rows + surface.rows) % surface.rows;
+    int c = peak.col + o;
+    float col_value = 0.0f;
+    if (cyclic_cols) {
+      col_value = surface(peak.row, (c % surface.cols + surface.cols) % surface.cols);
+    } else if (c >= 0 && c < surface.cols) {
+      col_value = surface(peak.row, c);
+    }
+    along_rows[o + kRadius] = std::pow(std::fabs(surface(r, peak.col)), 3.0f);
+    along_cols[o + kRadius] = std::pow(std::fabs(col_value), 3.0f);
+  }
+  return {gaussianWidth(along_cols, 2 * kRadius + 1, kRadius + peak.sub_col - peak.col, kRadius, false),
+          gaussianWidth(along_rows, 2 * kRadius + 1, kRadius + peak.sub_row - peak.row, kRadius, false)};
+}
+
+double confidenceFrom(double psr) {
+  return std::clamp((psr - kPsrFloor) / (kPsrGood - kPsrFloor), 0.0, 1.0);
+}
+
+}  // namespace
+
+const char* toString(RegistrationStatus status) {
+  switch (status) {
+    case RegistrationStatus::kOk: return "ok";
+    case RegistrationStatus::kLowConfidence: return "low_confidence";
+    case RegistrationStatus::kTextureless: return "textureless";
+  }
+  return "unknown";
+}
+
+Registrar::Registrar(const RegistrationConfig& config)
+    : Registrar(std::make_shared<const SpectralContext>(config)) {}
+
+Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
+    : context_(std::move(context)), builder_(context_) {}
+
+FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {
+  return builder_.build(image, order);
+}
+
+FrameSpectra Registrar::analyse(const PreparedImage& image) { return builder_.build(image); }
+
+double Registrar::logZoomPerBin() const { return std::log(context_->logPolarBase()); }
+
+PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameSpectra& newer,
+                                         RegistrationMethod method,
+                                         RegistrationSurfaces* surfaces) {
+  const int n = context_->size();
+  if (older.empty() || newer.empty()) throw InputError("registerPair: a frame is empty");
+  if (older.grey.rows != n || newer.grey.rows != n || older.spectrum.size() != newer.spectrum.size()) {
+    throw InputError("registerPair: frames were analysed at a different size than " +
+                     std::to_string(n));
+  }
+  PairRegistration result;
+  const double min_texture = context_->config().min_texture;
+  if (!(older.texture >= min_texture) || !(newer.texture >= min_texture)) {
+    // Nothing to correlate: report the prior (no motion) with uninformative sigmas.
+    result.status = RegistrationStatus::kTextureless;
+    result.rotation_sigma = CV_PI;
+    result.log_zoom_sigma = 1.0;
+    result.direction_sigma = CV_PI;
+    result.shift_sigma = n;
+    return result;
+  }
+  const double psr_rotation_zoom = registerRotationZoom(older, newer, method, result);
+  if (surfaces != nullptr) surfaces->rotation_zoom = surface_.clone();
+  const double psr_translation = registerTranslation(older, newer, method, result);
+  if (surfaces != nullptr) {
+    surfaces->translation = surface_.clone();
+    surfaces->translation_polar =
+        method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
+  }
+  result.confidence = std::min(confidenceFrom(psr_rotation_zoom), confidenceFrom(psr_translation));
+  result.status = result.confidence >= context_->config().min_confidence
+                      ? RegistrationStatus::kOk
+                      : RegistrationStatus::kLowConfidence;
+  return result;
+}
+
+double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
+                                     RegistrationMethod method, PairRegistration& result) {
+  const int n = context_->size();
+  normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
+  context_->fft().inverse(cross_power_, correlation_);
+  centredSurface(correlation_, surface_);
+  const SurfacePeak peak = findPeak(surface_, true);
+  const double log_zoom_per_bin = logZoomPerBin();
+  // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
+  result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
+  result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
+  result.rotation_zoom_peak = peak.value;
+  if (method == RegistrationMethod::kEnergyVectors) {
+    EnergyVectorOptions options;
+    options.block_radius = context_->config().block_radius;
+    options.cyclic_cols = true;
+    options.smoothing_sigma = context_->config().energy_smoothing_sigma;
+    EnergyVector zoom_vector = extractEnergyVector(surface_, peak, options);
+    result.rotation_sigma = zoom_vector.row_sigma * CV_PI / n;
+    result.log_zoom_sigma = zoom_vector.col_sigma * log_zoom_per_bin;
+    result.zoom_energy = std::move(zoom_vector.values);
+  } else {
+    const cv::Point2d widths = peakWidths(surface_, peak, true);
+    result.rotation_sigma = widths.y * CV_PI / n;
+    result.log_zoom_sigma = widths.x * log_zoom_per_bin;
+  }
+  return peakToSidelobeRatio(surface_, peak);
+}
+
+double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
+                                      RegistrationMethod method, PairRegistration& result) {
+  const int n = context_->size();
+  const cv::Point2f centre(n / 2.0f, n / 2.0f);
+  // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
+  const cv::Mat warp = cv::getRotationMatrix2D(centre, result.rotation * 180.0 / CV_PI, result.zoom);
+  cv::warpAffine(older.grey, warped_, warp, older.grey.size(), cv::INTER_LINEAR,
+                 cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::multiply(warped_, context_->window(), warped_);
+  context_->fft().forward(warped_, warped_spectrum_);
+
+  SurfacePeak peak;
+  if (context_->config().resolve_half_turn) {
+    // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
+    // hypothesis costs one more inverse FFT, not another warp.
+    normalisedCrossPowerBothTurns(newer.spectrum, warped_spectrum_, cross_power_,
+                                  cross_power_turned_);
+    context_->fft().inverse(cross_power_, correlation_);
+    centredSurface(correlation_, surface_);
+    context_->fft().inverse(cross_power_turned_, correlation_);
+    centredSurface(correlation_, surface_turned_);
+    peak = findPeak(surface_, true);
+    const SurfacePeak turned_peak = findPeak(surface_turned_, true);
+    if (turned_peak.value > peak.value) {
+      std::swap(surface_, surface_turned_);
+      peak = turned_peak;
+      result.half_turn = true;
+      result.rotation = wrapAngle(result.rotation + CV_PI);
+    }
+  } else {
+    normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_);
+    context_->fft().inverse(cross_power_, correlation_);
+    centredSurface(correlation_, surface_);
+    peak = findPeak(surface_, true);
+  }
+  result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
+  result.direction = std::atan2(result.translation.y, result.translation.x);
+  result.shift = std::hypot(result.translation.x, result.translation.y);
+  result.translation_peak = peak.value;
+  const double psr = peakToSidelobeRatio(surface_, peak);
+
+  if (method == RegistrationMethod::kEnergyVectors) {
+    // Polar unwrap: the depths of the scene lie along one direction at different radii (2.6).
+    context_->polar(surface_, polar_);
+    const SurfacePeak polar_peak = findPeak(polar_, false);
+    EnergyVectorOptions options;
+    options.block_radius = context_->config().block_radius;
+    options.cyclic_cols = false;
+    options.suppress_low_cols = true;
+    options.smoothing_sigma = context_->config().energy_smoothing_sigma;
+    EnergyVector shift_vector = extractEnergyVector(polar_, polar_peak, options);
+    result.direction_sigma = shift_vector.row_sigma * 2.0 * CV_PI / n;
+    result.shift_sigma = shift_vector.col_sigma * context_->polarRadiusStep();
+    result.translation_energy = std::move(shift_vector.values);
+  } else {
+    const cv::Point2d widths = peakWidths(surface_, peak, true);
+    result.shift_sigma = std::max(widths.x, widths.y);
+    result.direction_sigma = std::min(CV_PI, result.shift_sigma / std::max(result.shift, 1e-9));
+  }
+  return psr;
+}
+
+}  // namespace oefmt

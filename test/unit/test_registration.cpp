@@ -1,0 +1,272 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Invariants of the pair registration (algorithm spec section 8).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "oefmt/error.h"
+#include "oefmt/registration.h"
+#include "oefmt/sim/texture.h"
+#include "support/fixtures.h"
+
+namespace oefmt {
+namespace {
+
+using test::deg;
+using test::rad;
+
+constexpr int kN = 512;
+
+void expectFiniteSigmas(const PairRegistration& r) {
+  EXPECT_TRUE(std::isfinite(r.rotation_sigma));
+  EXPECT_TRUE(std::isfinite(r.log_zoom_sigma));
+  EXPECT_TRUE(std::isfinite(r.direction_sigma));
+  EXPECT_TRUE(std::isfinite(r.shift_sigma));
+  EXPECT_GT(r.rotation_sigma, 0.0);
+  EXPECT_GT(r.shift_sigma, 0.0);
+}
+
+TEST(Registration, IdentityGivesNoMotion) {
+  const auto pair = test::warpedPair(sim::ViewMotion{});
+  const PairRegistration r = test::registerImages(pair.older, pair.older);
+  EXPECT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(deg(r.rotation), 0.0, 0.05);
+  EXPECT_NEAR(r.zoom, 1.0, 0.002);
+  EXPECT_LT(r.shift, 0.1);
+  EXPECT_EQ(test::argmax(r.translation_energy), 0);
+  EXPECT_EQ(test::argmax(r.zoom_energy), kN / 2);
+  EXPECT_FALSE(r.half_turn);
+  EXPECT_GT(r.confidence, 0.9);
+  expectFiniteSigmas(r);
+}
+
+struct ShiftCase {
+  double tx, ty;
+};
+class PureShift : public ::testing::TestWithParam<ShiftCase> {};
+
+TEST_P(PureShift, SubPixelAccurate) {
+  const ShiftCase c = GetParam();
+  sim::ViewMotion motion;
+  motion.shift = {c.tx, c.ty};
+  const auto pair = test::warpedPair(motion);
+  const PairRegistration r = test::registerImages(pair.older, pair.newer);
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(r.translation.x, c.tx, 0.2);
+  EXPECT_NEAR(r.translation.y, c.ty, 0.2);
+  EXPECT_NEAR(deg(r.rotation), 0.0, 0.05);
+  EXPECT_NEAR(r.zoom, 1.0, 0.002);
+  const double length = std::hypot(c.tx, c.ty);
+  if (length > 1.0) {
+    EXPECT_NEAR(std::remainder(r.direction - std::atan2(c.ty, c.tx), 2 * CV_PI), 0.0, 0.02);
+    EXPECT_NEAR(test::argmax(r.translation_energy), std::round(length / 0.75), 1.0);
+  }
+  expectFiniteSigmas(r);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shifts, PureShift,
+                         ::testing::Values(ShiftCase{0.3, -0.2}, ShiftCase{5.25, -2.75},
+                                           ShiftCase{-17.4, 11.6}, ShiftCase{30.0, 0.0},
+                                           ShiftCase{28.5, -0.3}, ShiftCase{0.4, 39.6},
+                                           ShiftCase{-25.7, -28.1}, ShiftCase{-38.0, 0.2}));
+
+class PureRotation : public ::testing::TestWithParam<double> {};
+
+TEST_P(PureRotation, AngleWithinFiveHundredthsOfADegree) {
+  const double degrees = GetParam();
+  sim::ViewMotion motion;
+  motion.rotation = rad(degrees);
+  const auto pair = test::warpedPair(motion);
+  const PairRegistration r = test::registerImages(pair.older, pair.newer);
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(std::remainder(deg(r.rotation) - degrees, 360.0), 0.0, 0.05);
+  EXPECT_NEAR(r.zoom, 1.0, 0.002);
+  EXPECT_LT(r.shift, 0.3);
+  EXPECT_EQ(r.half_turn, std::fabs(degrees) > 90.0);
+  expectFiniteSigmas(r);
+}
+
+// Beyond +-90 degrees the log-polar spectrum is ambiguous by a half turn; the translation peak
+// resolves it.
+INSTANTIATE_TEST_SUITE_P(Rotations, PureRotation,
+                         ::testing::Values(1.3, -4.0, 10.6, -27.0, 45.0, -62.5, 85.0, 120.0,
+                                           -135.0, 170.0, -178.0));
+
+class PureZoom : public ::testing::TestWithParam<double> {};
+
+TEST_P(PureZoom, ScaleWithinTwoTenthsOfAPercent) {
+  const double zoom = GetParam();
+  sim::ViewMotion motion;
+  motion.zoom = zoom;
+  const auto pair = test::warpedPair(motion);
+  Registrar registrar(test::sharedContext(kN));
+  const PairRegistration r = test::registerImages(pair.older, pair.newer);
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(r.zoom / zoom, 1.0, 0.002);
+  EXPECT_NEAR(deg(r.rotation), 0.0, 0.05);
+  EXPECT_LT(r.shift, 0.3);
+  const double expected_bin = kN / 2 - std::log(zoom) / registrar.logZoomPerBin();
+  EXPECT_NEAR(test::argmax(r.zoom_energy), expected_bin, 1.0);
+  expectFiniteSigmas(r);
+}
+
+INSTANTIATE_TEST_SUITE_P(Zooms, PureZoom, ::testing::Values(0.8, 0.87, 0.95, 1.02, 1.1, 1.18, 1.25));
+
+TEST(Registration, SwappedInputsInvertTheMotion) {
+  sim::ViewMotion motion;
+  motion.rotation = rad(8.0);
+  motion.zoom = 1.07;
+  const auto pair = test::warpedPair(motion);
+  const PairRegistration forward = test::registerImages(pair.older, pair.newer);
+  const PairRegistration backward = test::registerImages(pair.newer, pair.older);
+  EXPECT_NEAR(deg(backward.rotation), -deg(forward.rotation), 0.05);
+  EXPECT_NEAR(backward.zoom * forward.zoom, 1.0, 0.002);
+  EXPECT_NEAR(deg(forward.rotation), 8.0, 0.05);
+  EXPECT_NEAR(forward.zoom, 1.07, 0.002);
+}
+
+TEST(Registration, CombinedWarpGivesShiftInNewerAxes) {
+  sim::ViewMotion motion;
+  motion.rotation = rad(-12.0);
+  motion.zoom = 1.08;
+  motion.shift = {7.5, -4.25};
+  const auto pair = test::warpedPair(motion);
+  const PairRegistration r = test::registerImages(pair.older, pair.newer);
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(deg(r.rotation), -12.0, 0.05);
+  EXPECT_NEAR(r.zoom, 1.08, 0.002);
+  EXPECT_NEAR(r.translation.x, 7.5, 0.2);
+  EXPECT_NEAR(r.translation.y, -4.25, 0.2);
+}
+
+TEST(Registration, ClassicMethodFindsTheSingleDominantMotion) {
+  sim::ViewMotion motion;
+  motion.rotation = rad(20.0);
+  motion.zoom = 0.9;
+  motion.shift = {-11.0, 6.5};
+  const auto pair = test::warpedPair(motion);
+  const PairRegistration r =
+      test::registerImages(pair.older, pair.newer, RegistrationMethod::kClassic);
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(deg(r.rotation), 20.0, 0.05);
+  EXPECT_NEAR(r.zoom, 0.9, 0.002);
+  EXPECT_NEAR(r.translation.x, -11.0, 0.2);
+  EXPECT_NEAR(r.translation.y, 6.5, 0.2);
+  EXPECT_TRUE(r.zoom_energy.empty());
+  EXPECT_TRUE(r.translation_energy.empty());
+  expectFiniteSigmas(r);
+}
+
+// Local maxima of v within +-tolerance of `bin` whose height is at least `fraction` of the
+// vector's maximum.
+bool hasPeakNear(const std::vector<float>& v, double bin, double tolerance, double fraction) {
+  const float top = v[test::argmax(v)];
+  for (int j = 1; j + 1 < static_cast<int>(v.size()); ++j) {
+    if (std::fabs(j - bin) > tolerance) continue;
+    if (v[j] >= v[j - 1] && v[j] >= v[j + 1] && v[j] >= fraction * top) return true;
+  }
+  return false;
+}
+
+TEST(Registration, TwoPlanesGiveTwoTranslationEnergyPeaks) {
+  const cv::Mat1f ground = sim::proceduralTexture({2048, 2048}, 11, sim::TextureStyle::kNoise, 40);
+  const cv::Mat1f roofs = sim::proceduralTexture({2048, 2048}, 12, sim::TextureStyle::kCells, 40);
+  const cv::Mat1f mask = sim::blockMask({2048, 2048}, 13, 96.0, 0.5);
+  const cv::Point2d centre(1024, 1024);
+  const double direction = rad(35.0);
+  const cv::Point2d unit(std::cos(direction), std::sin(direction));
+  const cv::Mat1f older = sim::renderTwoLayerView(ground, roofs, mask, centre, {0, 0}, {0, 0}, kN);
+  const cv::Mat1f newer =
+      sim::renderTwoLayerView(ground, roofs, mask, centre, unit * 10.0, unit * 20.0, kN);
+  const PairRegistration r = test::registerImages(older, newer);
+  ASSERT_NE(r.status, RegistrationStatus::kTextureless);
+  EXPECT_NEAR(std::remainder(r.direction - direction, 2 * CV_PI), 0.0, 0.03);
+  EXPECT_TRUE(hasPeakNear(r.translation_energy, 10.0 / 0.75, 1.0, 0.1));
+  EXPECT_TRUE(hasPeakNear(r.translation_energy, 20.0 / 0.75, 1.0, 0.1));
+
+  // The next pair at 1.5 times the speed stretches the vector by 1.5.
+  const cv::Mat1f faster =
+      sim::renderTwoLayerView(ground, roofs, mask, centre, unit * 25.0, unit * 50.0, kN);
+  const PairRegistration r2 = test::registerImages(newer, faster);
+  EXPECT_TRUE(hasPeakNear(r2.translation_energy, 15.0 / 0.75, 1.0, 0.1));
+  EXPECT_TRUE(hasPeakNear(r2.translation_energy, 30.0 / 0.75, 1.0, 0.1));
+}
+
+TEST(Registration, ConstantAndBlackFramesAreTextureless) {
+  const auto pair = test::warpedPair(sim::ViewMotion{});
+  const cv::Mat1f black(kN, kN, 0.0f);
+  const cv::Mat1f grey(kN, kN, 0.5f);
+  for (const cv::Mat1f& flat : {black, grey}) {
+    const PairRegistration r = test::registerImages(pair.older, flat);
+    EXPECT_EQ(r.status, RegistrationStatus::kTextureless);
+    EXPECT_EQ(r.confidence, 0.0);
+    EXPECT_TRUE(std::isfinite(r.rotation) && std::isfinite(r.zoom) && std::isfinite(r.shift));
+    EXPECT_FALSE(r.usable());
+  }
+}
+
+TEST(Registration, NanImageGivesAFiniteUnusableResult) {
+  const auto pair = test::warpedPair(sim::ViewMotion{});
+  const cv::Mat1f nan_image(kN, kN, std::numeric_limits<float>::quiet_NaN());
+  const PairRegistration r = test::registerImages(pair.older, nan_image);
+  EXPECT_EQ(r.status, RegistrationStatus::kTextureless);
+  EXPECT_TRUE(std::isfinite(r.translation.x) && std::isfinite(r.rotation));
+}
+
+TEST(Registration, SomeNanPixelsAreReplacedAndCounted) {
+  sim::ViewMotion motion;
+  motion.shift = {6.0, 3.0};
+  auto pair = test::warpedPair(motion);
+  cv::Mat1f damaged = pair.newer.clone();
+  damaged(cv::Rect(100, 100, 20, 20)).setTo(std::numeric_limits<float>::quiet_NaN());
+  damaged(300, 300) = std::numeric_limits<float>::infinity();
+  Registrar registrar(test::sharedContext(kN));
+  const FrameSpectra a = registrar.analyse(pair.older);
+  const FrameSpectra b = registrar.analyse(damaged);
+  EXPECT_EQ(b.invalid_pixels, 401);
+  const PairRegistration r = registrar.registerPair(a, b);
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(r.translation.x, 6.0, 0.2);
+  EXPECT_NEAR(r.translation.y, 3.0, 0.2);
+}
+
+TEST(Registration, UnrelatedImagesHaveLowConfidence) {
+  const auto a = test::warpedPair(sim::ViewMotion{}, kN, 21);
+  const auto b = test::warpedPair(sim::ViewMotion{}, kN, 22);
+  const PairRegistration r = test::registerImages(a.older, b.older);
+  EXPECT_EQ(r.status, RegistrationStatus::kLowConfidence);
+  EXPECT_LT(r.confidence, 0.15);
+}
+
+TEST(Registration, BadInputIsAClearError) {
+  Registrar registrar(test::sharedContext(kN));
+  EXPECT_THROW(registrar.analyse(cv::Mat()), InputError);
+  EXPECT_THROW(registrar.registerPair(FrameSpectra{}, FrameSpectra{}), InputError);
+  // Frames analysed at another size cannot be paired.
+  Registrar small(test::sharedContext(128));
+  const auto pair = test::warpedPair(sim::ViewMotion{});
+  const FrameSpectra big_frame = registrar.analyse(pair.older);
+  const FrameSpectra small_frame = small.analyse(pair.older);
+  EXPECT_THROW(registrar.registerPair(big_frame, small_frame), InputError);
+  try {
+    registrar.analyse(cv::Mat(64, 64, CV_8SC1, cv::Scalar(1)));
+    FAIL() << "a signed 8-bit image was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("CV_8S"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Registration, SmallSizesWork) {
+  sim::ViewMotion motion;
+  motion.shift = {3.5, -2.0};
+  motion.rotation = rad(5.0);
+  const auto pair = test::warpedPair(motion, 128);
+  const PairRegistration r = test::registerImages(pair.older, pair.newer);
+  EXPECT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(deg(r.rotation), 5.0, 0.3);
+  EXPECT_NEAR(r.translation.x, 3.5, 0.3);
+  EXPECT_NEAR(r.translation.y, -2.0, 0.3);
+}
+
+}  // namespace
+}  // namespace oefmt
