@@ -142,9 +142,9 @@ double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak) {
   }
   if (count < 2) return 0.0;
   const double mean = sum / count;
-  const double variance = std::max(sum_sq / count - mean * mean, 0.0);
-  if (variance <= 0.0) return 0.0;
-  return (peak.value - mean) / std::sqrt(variance);
+  // A perfect match leaves (almost) no sidelobe energy: bound the ratio instead of dividing by 0.
+  const double deviation = std::max(std::sqrt(std::max(sum_sq / count - mean * mean, 0.0)), 1e-6);
+  return (peak.value - mean) / deviation;
 }
 
 }  // namespace oefmt

@@ -1,2 +1,207 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-int main() { return 0; }
+// oefmt_benchmark: time of one pair registration at N = 512 and of each of its stages.
+// Single-threaded by default (OpenCV's thread pool off; FFTW is single-threaded);
+// pass --threads K to let OpenCV use K threads.
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "oefmt/energy_vector.h"
+#include "oefmt/phase_correlation.h"
+#include "oefmt/registration.h"
+#include "oefmt/sim/similarity_views.h"
+#include "oefmt/sim/texture.h"
+
+namespace {
+
+constexpr int kN = 512;
+
+// Inputs shared by every benchmark: two 8-bit BGR camera frames related by a known motion.
+struct Inputs {
+  std::shared_ptr<const oefmt::SpectralContext> context;
+  cv::Mat older_raw, newer_raw;
+  oefmt::PreparedImage older, newer;
+
+  Inputs() {
+    oefmt::RegistrationConfig config;
+    config.size = kN;
+    context = std::make_shared<const oefmt::SpectralContext>(config);
+    const cv::Mat1f texture = oefmt::sim::proceduralTexture({2048, 2048}, 3);
+    oefmt::sim::ViewMotion motion;
+    motion.rotation = 0.05;
+    motion.zoom = 1.03;
+    motion.shift = {14.0, -9.0};
+    older_raw = toBgr(oefmt::sim::renderView(texture, {1024, 1024}, {}, kN));
+    newer_raw = toBgr(oefmt::sim::renderView(texture, {1024, 1024}, motion, kN));
+    older = oefmt::prepareImage(older_raw, kN);
+    newer = oefmt::prepareImage(newer_raw, kN);
+  }
+
+  static cv::Mat toBgr(const cv::Mat1f& grey) {
+    cv::Mat grey8, bgr;
+    grey.convertTo(grey8, CV_8U, 255.0);
+    cv::cvtColor(grey8, bgr, cv::COLOR_GRAY2BGR);
+    return bgr;
+  }
+};
+
+Inputs& inputs() {
+  static Inputs instance;
+  return instance;
+}
+
+void BM_PairFromRawImages(benchmark::State& state) {
+  oefmt::Registrar registrar(inputs().context);
+  for (auto _ : state) {
+    const oefmt::FrameSpectra a = registrar.analyse(inputs().older_raw);
+    const oefmt::FrameSpectra b = registrar.analyse(inputs().newer_raw);
+    benchmark::DoNotOptimize(registrar.registerPair(a, b));
+  }
+}
+BENCHMARK(BM_PairFromRawImages)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void BM_PairWithCachedOlder(benchmark::State& state) {
+  oefmt::Registrar registrar(inputs().context);
+  const oefmt::FrameSpectra a = registrar.analyse(inputs().older_raw);
+  for (auto _ : state) {
+    const oefmt::FrameSpectra b = registrar.analyse(inputs().newer_raw);
+    benchmark::DoNotOptimize(registrar.registerPair(a, b));
+  }
+}
+BENCHMARK(BM_PairWithCachedOlder)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void BM_RegisterCachedSpectra(benchmark::State& state) {
+  oefmt::Registrar registrar(inputs().context);
+  const oefmt::FrameSpectra a = registrar.analyse(inputs().older);
+  const oefmt::FrameSpectra b = registrar.analyse(inputs().newer);
+  for (auto _ : state) benchmark::DoNotOptimize(registrar.registerPair(a, b));
+}
+BENCHMARK(BM_RegisterCachedSpectra)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void BM_RegisterCachedSpectraClassic(benchmark::State& state) {
+  oefmt::Registrar registrar(inputs().context);
+  const oefmt::FrameSpectra a = registrar.analyse(inputs().older);
+  const oefmt::FrameSpectra b = registrar.analyse(inputs().newer);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(registrar.registerPair(a, b, oefmt::RegistrationMethod::kClassic));
+  }
+}
+BENCHMARK(BM_RegisterCachedSpectraClassic)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// ---- Stages -------------------------------------------------------------------------------
+
+void BM_Stage_PrepareImage(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(oefmt::prepareImage(inputs().newer_raw, kN));
+}
+BENCHMARK(BM_Stage_PrepareImage)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_FrameSpectra(benchmark::State& state) {
+  oefmt::SpectraBuilder builder(inputs().context);
+  for (auto _ : state) benchmark::DoNotOptimize(builder.build(inputs().newer));
+}
+BENCHMARK(BM_Stage_FrameSpectra)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_ForwardFft(benchmark::State& state) {
+  cv::Mat2f spectrum;
+  for (auto _ : state) {
+    inputs().context->fft().forward(inputs().newer.grey, spectrum);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_ForwardFft)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_InverseFft(benchmark::State& state) {
+  cv::Mat2f spectrum, scratch;
+  cv::Mat1f image;
+  inputs().context->fft().forward(inputs().newer.grey, spectrum);
+  for (auto _ : state) {
+    spectrum.copyTo(scratch);
+    inputs().context->fft().inverse(scratch, image);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_InverseFft)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_MagnitudeAndLogPolar(benchmark::State& state) {
+  cv::Mat2f spectrum;
+  cv::Mat1f magnitude, log_polar;
+  inputs().context->fft().forward(inputs().newer.grey, spectrum);
+  for (auto _ : state) {
+    oefmt::centredMagnitude(spectrum, inputs().context->highPass(), magnitude);
+    inputs().context->logPolar(magnitude, log_polar);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_MagnitudeAndLogPolar)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_CrossPowerBothTurns(benchmark::State& state) {
+  oefmt::SpectraBuilder builder(inputs().context);
+  const oefmt::FrameSpectra a = builder.build(inputs().older);
+  const oefmt::FrameSpectra b = builder.build(inputs().newer);
+  cv::Mat2f same, turned;
+  for (auto _ : state) {
+    oefmt::normalisedCrossPowerBothTurns(b.spectrum, a.spectrum, same, turned);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_CrossPowerBothTurns)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_WarpOlder(benchmark::State& state) {
+  const cv::Mat warp = cv::getRotationMatrix2D({kN / 2.0f, kN / 2.0f}, 3.0, 1.03);
+  cv::Mat1f warped;
+  for (auto _ : state) {
+    cv::warpAffine(inputs().older.grey, warped, warp, inputs().older.grey.size(), cv::INTER_LINEAR,
+                   cv::BORDER_CONSTANT, cv::Scalar(0));
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_WarpOlder)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_PolarUnwrap(benchmark::State& state) {
+  cv::Mat1f polar;
+  for (auto _ : state) {
+    inputs().context->polar(inputs().newer.grey, polar);
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_PolarUnwrap)->Unit(benchmark::kMicrosecond);
+
+void BM_Stage_PeakAndEnergyVector(benchmark::State& state) {
+  oefmt::Registrar registrar(inputs().context);
+  const oefmt::FrameSpectra a = registrar.analyse(inputs().older);
+  const oefmt::FrameSpectra b = registrar.analyse(inputs().newer);
+  oefmt::RegistrationSurfaces surfaces;
+  registrar.registerPair(a, b, oefmt::RegistrationMethod::kEnergyVectors, &surfaces);
+  oefmt::EnergyVectorOptions options;
+  for (auto _ : state) {
+    const oefmt::SurfacePeak peak = oefmt::findPeak(surfaces.rotation_zoom, true);
+    benchmark::DoNotOptimize(oefmt::extractEnergyVector(surfaces.rotation_zoom, peak, options));
+    benchmark::DoNotOptimize(oefmt::peakToSidelobeRatio(surfaces.rotation_zoom, peak));
+  }
+}
+BENCHMARK(BM_Stage_PeakAndEnergyVector)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int threads = 1;
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::strcmp(argv[i], "--threads") == 0) {
+      threads = std::atoi(argv[i + 1]);
+      for (int j = i; j + 2 <= argc; ++j) argv[j] = argv[j + 2];
+      argc -= 2;
+      break;
+    }
+  }
+  cv::setNumThreads(threads);
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
