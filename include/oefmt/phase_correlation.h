@@ -4,16 +4,21 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/fft.h"
+
 namespace oefmt {
 
 /// out = newer * conj(older) / |newer * conj(older)|, 0 where the product vanishes.
 /// With P = newer, Q = older and P(x) = Q(x - t), the correlation peaks at t.
-void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out);
+/// With half_turn, older is taken turned by 180 degrees about the centre, whose spectrum is
+/// conj(older) for a real image: out = newer * older / |newer * older|.
+void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
+                          bool half_turn = false);
 
-/// The cross powers of newer against older and against older turned by 180 degrees about the
-/// centre (whose spectrum is conj(older) for a real image): one pass over the spectra.
-void normalisedCrossPowerBothTurns(const cv::Mat2f& newer, const cv::Mat2f& older,
-                                   cv::Mat2f& out_same, cv::Mat2f& out_half_turn);
+/// Height of the phase-correlation peak computed from the lowest frequencies only (an
+/// M x M correlation with M = small.size()): a cheap test of which of two hypotheses matches.
+double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
+                         const Fft2d& small, cv::Mat2f& scratch_spectrum, cv::Mat1f& scratch_surface);
 
 /// surface = fftshift(correlation) / N^2: a shift t peaks at (N/2, N/2) + t. Signed values.
 void centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface);
@@ -33,7 +38,7 @@ struct SurfacePeak {
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols);
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
-/// peak. About 5 for unrelated images at N = 512, tens for a clean registration.
+/// peak. About 15 for unrelated textures at N = 512, hundreds for a clean registration.
 double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak);
 
 }  // namespace oefmt

@@ -51,7 +51,9 @@ struct PairRegistration {
 struct RegistrationSurfaces {
   cv::Mat1f rotation_zoom;      ///< rows: rotation, columns: log-zoom (centred)
   cv::Mat1f translation;        ///< centred Cartesian translation surface
-  cv::Mat1f translation_polar;  ///< rows: direction, columns: radius (energy-vector method only)
+  cv::Mat1f translation_polar;  ///< rows: direction, columns: radius (energy-vector method only):
+                                ///< the band of rows around the peak direction that was unwrapped
+  int translation_polar_first_row = 0;  ///< direction row of translation_polar's first row
 };
 
 /// Registers frame pairs. Holds per-thread scratch buffers, so use one Registrar per thread;
@@ -88,9 +90,10 @@ class Registrar {
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
   // Scratch, reused across calls.
-  cv::Mat2f cross_power_, cross_power_turned_;
-  cv::Mat1f correlation_, surface_, surface_turned_, warped_, polar_;
+  cv::Mat2f cross_power_, small_spectrum_;
+  cv::Mat1f correlation_, surface_, small_surface_, warped_, polar_;
   cv::Mat2f warped_spectrum_;
+  int polar_first_row_ = 0;
 };
 
 }  // namespace oefmt

@@ -10,6 +10,7 @@
 #include "oefmt/config.h"
 #include "oefmt/fft.h"
 #include "oefmt/image_prep.h"
+#include "oefmt/remap_table.h"
 
 namespace oefmt {
 
@@ -23,6 +24,9 @@ class SpectralContext {
   const RegistrationConfig& config() const { return config_; }
   int size() const { return config_.size; }
   const Fft2d& fft() const { return fft_; }
+  /// Small FFT for the low-resolution half-turn test (size halfTurnTestSize()).
+  const Fft2d& smallFft() const { return small_fft_; }
+  int halfTurnTestSize() const { return small_fft_.size(); }
 
   const cv::Mat1f& window() const { return window_; }
   const cv::Mat1f& highPass() const { return high_pass_; }
@@ -31,10 +35,12 @@ class SpectralContext {
   /// Pixels of shift per column of the translation polar unwrap.
   double polarRadiusStep() const { return polar_radius_step_; }
 
-  /// |centred spectrum| * high-pass -> log-polar (rows: angle 0..-pi, columns: log radius).
-  void logPolar(const cv::Mat1f& centred_magnitude, cv::Mat1f& out) const;
-  /// Centred correlation surface -> polar (rows: direction 0..2pi, columns: radius).
-  void polar(const cv::Mat1f& centred_surface, cv::Mat1f& out) const;
+  /// Upper half of the centred, high-passed magnitude (see upperHalfMagnitude) -> log-polar
+  /// (rows: angle 0..-pi, columns: log radius). Bilinear.
+  void logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out) const;
+  /// Rows first_row .. first_row + count - 1 (cyclic) of the polar unwrap of a centred
+  /// correlation surface (rows: direction 2 pi row / N, columns: radius). Bilinear.
+  void polarRows(const cv::Mat1f& centred_surface, int first_row, int count, cv::Mat1f& out) const;
 
  private:
   RegistrationConfig config_;
@@ -43,8 +49,9 @@ class SpectralContext {
   cv::Mat1f high_pass_;
   double log_polar_base_;
   double polar_radius_step_;
-  cv::Mat log_polar_map1_, log_polar_map2_;
-  cv::Mat polar_map1_, polar_map2_;
+  Fft2d small_fft_;
+  BilinearRemapTable log_polar_table_;
+  BilinearRemapTable polar_table_;
 };
 
 /// What the registration needs of one frame; computed once when the frame arrives.
@@ -77,8 +84,9 @@ class SpectraBuilder {
   cv::Mat1f log_polar_;
 };
 
-/// Writes |spectrum| * filter into the centred N x N image `magnitude` (DC at (N/2, N/2)),
-/// filling the half the real FFT omits by Hermitian symmetry.
-void centredMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude);
+/// Writes rows 0 .. N/2 + 1 of the centred N x N image |spectrum| * filter (DC at (N/2, N/2)):
+/// the half plane the log-polar transform samples (the magnitude is point-symmetric), filling
+/// the columns the real FFT omits by Hermitian symmetry. `filter` is the full N x N filter.
+void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude);
 
 }  // namespace oefmt

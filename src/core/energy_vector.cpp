@@ -75,7 +75,10 @@ EnergyVector extractEnergyVector(const cv::Mat1f& surface, const SurfacePeak& pe
 
   std::vector<float> row_energy(rows, 0.0f);
   double column0 = 0.0, total = 0.0;
-  for (int r = 0; r < rows; ++r) {
+  const bool banded = options.row_band > 0 && 2 * options.row_band + 1 < rows;
+  const int band_rows = banded ? 2 * options.row_band + 1 : rows;
+  for (int i = 0; i < band_rows; ++i) {
+    const int r = banded ? wrap(peak.row - options.row_band + i, rows) : i;
     const float* row = surface[r];
     double acc = 0.0;
     for (int c = first_col; c < cols; ++c) acc += cube(row[c]);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/image_prep.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -81,17 +82,22 @@ PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
   const int side = std::min(grey.cols, grey.rows);
   const cv::Rect square((grey.cols - side) / 2, (grey.rows - side) / 2, side, side);
   PreparedImage prepared;
-  cv::Mat1f cropped = grey(square).clone();
-  prepared.invalid_pixels = replaceNonFinite(cropped);
+  cv::Mat1f cropped = side == grey.cols && side == grey.rows ? grey : grey(square).clone();
+  // Only float inputs can hold NaN/inf; a finite sum (vectorised) proves there are none.
+  const int depth = image.depth();
+  if ((depth == CV_32F || depth == CV_64F) && !std::isfinite(cv::sum(cropped)[0])) {
+    prepared.invalid_pixels = replaceNonFinite(cropped);
+  }
   if (side == size) {
     prepared.grey = cropped;
   } else {
     cv::resize(cropped, prepared.grey, cv::Size(size, size), 0.0, 0.0,
                side > size ? cv::INTER_AREA : cv::INTER_LINEAR);
   }
-  cv::Scalar mean, stddev;
-  cv::meanStdDev(prepared.grey, mean, stddev);
-  prepared.texture = stddev[0];
+  const double count = static_cast<double>(prepared.grey.total());
+  const double mean = cv::sum(prepared.grey)[0] / count;
+  const double mean_square = cv::norm(prepared.grey, cv::NORM_L2SQR) / count;
+  prepared.texture = std::sqrt(std::max(mean_square - mean * mean, 0.0));
   return prepared;
 }
 

@@ -5,12 +5,11 @@
 #include <cmath>
 
 #include "oefmt/error.h"
-#include "oefmt/fft.h"
 
 namespace oefmt {
 namespace {
 
-constexpr float kTinyMagnitude = 1e-30f;
+constexpr float kTinyMagnitudeSquared = 1e-30f;
 
 void requireSameShape(const cv::Mat2f& a, const cv::Mat2f& b) {
   if (a.size() != b.size() || !a.isContinuous() || !b.isContinuous()) {
@@ -19,6 +18,21 @@ void requireSameShape(const cv::Mat2f& a, const cv::Mat2f& b) {
 }
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+// Normalised cross power of `count` interleaved complex values; the loop has no branch and
+// no call, so the compiler vectorises it.
+void crossPowerRun(const float* p, const float* q, float* out, int count, float conjugate_sign) {
+  for (int i = 0; i < count; ++i) {
+    const float pr = p[2 * i], pi = p[2 * i + 1];
+    const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
+    const float re = pr * qr + pi * qi;
+    const float im = pi * qr - pr * qi;
+    // + tiny keeps 0/0 out without a branch: a vanished product stays 0.
+    const float inv = 1.0f / std::sqrt(re * re + im * im + kTinyMagnitudeSquared);
+    out[2 * i] = re * inv;
+    out[2 * i + 1] = im * inv;
+  }
+}
 
 // Sub-sample offset of a Dirichlet (sinc) peak from the peak and its two neighbours:
 // for an ideal shift d in (0, 1), C(1) / C(0) = d / (1 - d).
@@ -35,44 +49,33 @@ double sincRatioOffset(float left, float centre, float right) {
 
 }  // namespace
 
-void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out) {
+void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
+                          bool half_turn) {
   requireSameShape(newer, older);
   out.create(newer.size());
-  const Complex* p = complexData(newer);
-  const Complex* q = complexData(older);
-  Complex* o = complexData(out);
-  const size_t count = newer.total();
-  for (size_t i = 0; i < count; ++i) {
-    const float re = p[i].real() * q[i].real() + p[i].imag() * q[i].imag();
-    const float im = p[i].imag() * q[i].real() - p[i].real() * q[i].imag();
-    const float m = std::sqrt(re * re + im * im);
-    o[i] = m > kTinyMagnitude ? Complex(re / m, im / m) : Complex(0.0f, 0.0f);
-  }
+  // older * conj -> p * conj(q); half turn: p * q (conj(conj(q))).
+  crossPowerRun(newer.ptr<float>(), older.ptr<float>(), out.ptr<float>(),
+                static_cast<int>(newer.total()), half_turn ? -1.0f : 1.0f);
 }
 
-void normalisedCrossPowerBothTurns(const cv::Mat2f& newer, const cv::Mat2f& older,
-                                   cv::Mat2f& out_same, cv::Mat2f& out_half_turn) {
+double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
+                         const Fft2d& small, cv::Mat2f& scratch_spectrum,
+                         cv::Mat1f& scratch_surface) {
   requireSameShape(newer, older);
-  out_same.create(newer.size());
-  out_half_turn.create(newer.size());
-  const Complex* p = complexData(newer);
-  const Complex* q = complexData(older);
-  Complex* same = complexData(out_same);
-  Complex* turned = complexData(out_half_turn);
-  const size_t count = newer.total();
-  for (size_t i = 0; i < count; ++i) {
-    const float pr = p[i].real(), pi = p[i].imag(), qr = q[i].real(), qi = q[i].imag();
-    // p * conj(q) and p * q have the same magnitude |p||q|.
-    const float m = std::sqrt((pr * pr + pi * pi) * (qr * qr + qi * qi));
-    if (m > kTinyMagnitude) {
-      const float inv = 1.0f / m;
-      same[i] = Complex((pr * qr + pi * qi) * inv, (pi * qr - pr * qi) * inv);
-      turned[i] = Complex((pr * qr - pi * qi) * inv, (pi * qr + pr * qi) * inv);
-    } else {
-      same[i] = Complex(0.0f, 0.0f);
-      turned[i] = Complex(0.0f, 0.0f);
-    }
+  const int n = newer.rows;
+  const int m = small.size();
+  scratch_spectrum.create(m, small.spectrumCols());
+  for (int i = 0; i < m; ++i) {
+    // Small row i holds frequency fy = i (i < m/2) or i - m; take it from big row fy mod N.
+    const int fy = i < m / 2 ? i : i - m;
+    const int big_row = wrap(fy, n);
+    crossPowerRun(newer.ptr<float>(big_row), older.ptr<float>(big_row),
+                  scratch_spectrum.ptr<float>(i), small.spectrumCols(), half_turn ? -1.0f : 1.0f);
   }
+  small.inverse(scratch_spectrum, scratch_surface);
+  double min_value = 0.0, max_value = 0.0;
+  cv::minMaxLoc(scratch_surface, &min_value, &max_value);
+  return std::max(max_value, -min_value) / (static_cast<double>(m) * m);
 }
 
 void centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface) {
@@ -90,23 +93,17 @@ void centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface) {
 
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols) {
   if (surface.empty()) throw InputError("findPeak: empty surface");
+  double min_value = 0.0, max_value = 0.0;
+  cv::Point min_at, max_at;
+  cv::minMaxLoc(surface, &min_value, &max_value, &min_at, &max_at);
+  const bool negative = -min_value > max_value;
+  const cv::Point at = negative ? min_at : max_at;
   SurfacePeak peak;
-  float best = -1.0f;
-  for (int r = 0; r < surface.rows; ++r) {
-    const float* row = surface[r];
-    for (int c = 0; c < surface.cols; ++c) {
-      const float v = std::fabs(row[c]);
-      if (v > best) {
-        best = v;
-        peak.row = r;
-        peak.col = c;
-      }
-    }
-  }
-  const float centre = surface(peak.row, peak.col);
-  const float sign = centre < 0.0f ? -1.0f : 1.0f;
-  peak.value = std::fabs(centre);
-  auto at = [&](int r, int c) -> float {
+  peak.row = at.y;
+  peak.col = at.x;
+  const float sign = negative ? -1.0f : 1.0f;
+  peak.value = static_cast<float>(negative ? -min_value : max_value);
+  auto sample = [&](int r, int c) -> float {
     r = wrap(r, surface.rows);
     if (cyclic_cols) {
       c = wrap(c, surface.cols);
@@ -115,29 +112,26 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols) {
     }
     return sign * surface(r, c);
   };
-  peak.sub_row = peak.row + sincRatioOffset(at(peak.row - 1, peak.col), peak.value,
-                                            at(peak.row + 1, peak.col));
-  peak.sub_col = peak.col + sincRatioOffset(at(peak.row, peak.col - 1), peak.value,
-                                            at(peak.row, peak.col + 1));
+  peak.sub_row = peak.row + sincRatioOffset(sample(peak.row - 1, peak.col), peak.value,
+                                            sample(peak.row + 1, peak.col));
+  peak.sub_col = peak.col + sincRatioOffset(sample(peak.row, peak.col - 1), peak.value,
+                                            sample(peak.row, peak.col + 1));
   return peak;
 }
 
 double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak) {
   constexpr int kExclude = 5;
-  double sum = 0.0, sum_sq = 0.0;
-  long count = 0;
-  for (int r = 0; r < surface.rows; ++r) {
-    int dr = std::abs(r - peak.row);
-    dr = std::min(dr, surface.rows - dr);
-    const float* row = surface[r];
-    for (int c = 0; c < surface.cols; ++c) {
-      int dc = std::abs(c - peak.col);
-      dc = std::min(dc, surface.cols - dc);
-      if (dr <= kExclude && dc <= kExclude) continue;
-      const double v = std::fabs(row[c]);
-      sum += v;
-      sum_sq += v * v;
-      ++count;
+  // Whole-surface sums (vectorised by OpenCV), minus the window around the peak.
+  double sum = cv::norm(surface, cv::NORM_L1);
+  double sum_sq = cv::norm(surface, cv::NORM_L2SQR);
+  long count = static_cast<long>(surface.total());
+  for (int dr = -kExclude; dr <= kExclude; ++dr) {
+    for (int dc = -kExclude; dc <= kExclude; ++dc) {
+      const double v = std::fabs(surface(wrap(peak.row + dr, surface.rows),
+                                         wrap(peak.col + dc, surface.cols)));
+      sum -= v;
+      sum_sq -= v * v;
+      --count;
     }
   }
   if (count < 2) return 0.0;

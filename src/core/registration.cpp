@@ -12,6 +12,7 @@
 #include "oefmt/energy_vector.h"
 #include "oefmt/error.h"
 #include "oefmt/phase_correlation.h"
+#include "oefmt/warp.h"
 
 namespace oefmt {
 namespace {
@@ -20,6 +21,11 @@ namespace {
 // N = 512, a clean registration well above 20.
 constexpr double kPsrFloor = 20.0;
 constexpr double kPsrGood = 60.0;
+
+// Rows of the polar unwrap (and of the rotation/zoom surface) that compete for the energy row:
+// rows further than 10 from the peak are overruled by the peak row anyway (spec 2.4 step 4b).
+constexpr int kPolarBandHalfWidth = 16;
+constexpr int kEnergyRowBand = 12;
 
 double wrapAngle(double a) {
   a = std::fmod(a + CV_PI, 2.0 * CV_PI);
@@ -104,6 +110,7 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     surfaces->translation = surface_.clone();
     surfaces->translation_polar =
         method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
+    surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
   }
   if (std::getenv("OEFMT_DEBUG_PSR")) std::fprintf(stderr, "psr rz %.2f t %.2f\n", psr_rotation_zoom, psr_translation);
   result.confidence = std::min(confidenceFrom(psr_rotation_zoom), confidenceFrom(psr_translation));
@@ -129,6 +136,7 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
     EnergyVectorOptions options;
     options.block_radius = context_->config().block_radius;
     options.cyclic_cols = true;
+    options.row_band = kEnergyRowBand;
     options.smoothing_sigma = context_->config().energy_smoothing_sigma;
     EnergyVector zoom_vector = extractEnergyVector(surface_, peak, options);
     result.rotation_sigma = zoom_vector.row_sigma * CV_PI / n;
@@ -145,38 +153,27 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
 double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
                                       RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
-  const cv::Point2f centre(n / 2.0f, n / 2.0f);
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
-  const cv::Mat warp = cv::getRotationMatrix2D(centre, result.rotation * 180.0 / CV_PI, result.zoom);
-  cv::warpAffine(older.grey, warped_, warp, older.grey.size(), cv::INTER_LINEAR,
-                 cv::BORDER_CONSTANT, cv::Scalar(0));
-  cv::multiply(warped_, context_->window(), warped_);
+  warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped_);
   context_->fft().forward(warped_, warped_spectrum_);
 
-  SurfacePeak peak;
   if (context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
-    // hypothesis costs one more inverse FFT, not another warp.
-    normalisedCrossPowerBothTurns(newer.spectrum, warped_spectrum_, cross_power_,
-                                  cross_power_turned_);
-    context_->fft().inverse(cross_power_, correlation_);
-    centredSurface(correlation_, surface_);
-    context_->fft().inverse(cross_power_turned_, correlation_);
-    centredSurface(correlation_, surface_turned_);
-    peak = findPeak(surface_, true);
-    const SurfacePeak turned_peak = findPeak(surface_turned_, true);
-    if (turned_peak.value > peak.value) {
-      std::swap(surface_, surface_turned_);
-      peak = turned_peak;
+    // hypothesis needs no second warp; a low-resolution correlation decides between the two
+    // and only the winner gets the full-size inverse FFT.
+    const double same = lowResolutionPeak(newer.spectrum, warped_spectrum_, false,
+                                          context_->smallFft(), small_spectrum_, small_surface_);
+    const double turned = lowResolutionPeak(newer.spectrum, warped_spectrum_, true,
+                                            context_->smallFft(), small_spectrum_, small_surface_);
+    if (turned > same) {
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
-  } else {
-    normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_);
-    context_->fft().inverse(cross_power_, correlation_);
-    centredSurface(correlation_, surface_);
-    peak = findPeak(surface_, true);
   }
+  normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_, result.half_turn);
+  context_->fft().inverse(cross_power_, correlation_);
+  centredSurface(correlation_, surface_);
+  const SurfacePeak peak = findPeak(surface_, true);
   result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
   result.direction = std::atan2(result.translation.y, result.translation.x);
   result.shift = std::hypot(result.translation.x, result.translation.y);
@@ -185,7 +182,11 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
 
   if (method == RegistrationMethod::kEnergyVectors) {
     // Polar unwrap: the depths of the scene lie along one direction at different radii (2.6).
-    context_->polar(surface_, polar_);
+    // Only a band of direction rows around the peak's direction can win (see row_band).
+    const int band = kPolarBandHalfWidth;
+    const int centre_row = static_cast<int>(std::lround(result.direction * n / (2.0 * CV_PI)));
+    polar_first_row_ = centre_row - band;
+    context_->polarRows(surface_, polar_first_row_, 2 * band + 1, polar_);
     const SurfacePeak polar_peak = findPeak(polar_, false);
     EnergyVectorOptions options;
     options.block_radius = context_->config().block_radius;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/spectra.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -42,19 +43,6 @@ cv::Mat1f makeHighPass(int n) {
   return filter;
 }
 
-// Builds fixed-point remap tables from a function (row, col) -> source (x, y).
-template <typename Sampler>
-void makeMaps(int n, Sampler sample, cv::Mat& map1, cv::Mat& map2) {
-  cv::Mat2f map(n, n);
-  for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) {
-      const cv::Point2d p = sample(r, c);
-      map(r, c) = cv::Vec2f(static_cast<float>(p.x), static_cast<float>(p.y));
-    }
-  }
-  cv::convertMaps(map, cv::noArray(), map1, map2, CV_16SC2);
-}
-
 }  // namespace
 
 SpectralContext::SpectralContext(const RegistrationConfig& config)
@@ -63,54 +51,54 @@ SpectralContext::SpectralContext(const RegistrationConfig& config)
       window_(makeWindow(config.size, config.taper_fraction)),
       high_pass_(makeHighPass(config.size)),
       log_polar_base_(std::pow(config.logpolar_radius_fraction * config.size, 1.0 / config.size)),
-      polar_radius_step_(config.polar_radius_fraction) {
+      polar_radius_step_(config.polar_radius_fraction),
+      small_fft_(std::min(128, config.size / 2), config.fft_planning) {
   const int n = config.size;
   const double centre = n / 2;
   const double base = log_polar_base_;
-  // Rows span exactly pi (the magnitude is point-symmetric), so the row axis is cyclic.
-  makeMaps(n, [&](int r, int c) {
+  // Rows span exactly pi (the magnitude is point-symmetric), so the row axis is cyclic. Angles
+  // 0..-pi only reach the upper half plane: rows 0..N/2 (+1 for the bilinear neighbour).
+  log_polar_table_ = BilinearRemapTable({n, n}, {n, n / 2 + 2}, [&](int r, int c) {
     const double angle = -CV_PI * r / n;
     const double radius = std::pow(base, c);
     return cv::Point2d(centre + radius * std::cos(angle), centre + radius * std::sin(angle));
-  }, log_polar_map1_, log_polar_map2_);
+  });
   const double step = polar_radius_step_;
-  makeMaps(n, [&](int r, int c) {
+  polar_table_ = BilinearRemapTable({n, n}, {n, n}, [&](int r, int c) {
     const double direction = 2.0 * CV_PI * r / n;
     const double radius = step * c;
     return cv::Point2d(centre + radius * std::cos(direction), centre + radius * std::sin(direction));
-  }, polar_map1_, polar_map2_);
+  });
 }
 
-void SpectralContext::logPolar(const cv::Mat1f& centred_magnitude, cv::Mat1f& out) const {
-  cv::remap(centred_magnitude, out, log_polar_map1_, log_polar_map2_, cv::INTER_CUBIC,
-            cv::BORDER_CONSTANT, cv::Scalar(0));
+void SpectralContext::logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out) const {
+  log_polar_table_.apply(upper_half_magnitude, out);
 }
 
-void SpectralContext::polar(const cv::Mat1f& centred_surface, cv::Mat1f& out) const {
-  cv::remap(centred_surface, out, polar_map1_, polar_map2_, cv::INTER_CUBIC, cv::BORDER_CONSTANT,
-            cv::Scalar(0));
+void SpectralContext::polarRows(const cv::Mat1f& centred_surface, int first_row, int count,
+                                cv::Mat1f& out) const {
+  polar_table_.applyRows(centred_surface, first_row, count, out);
 }
 
-void centredMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude) {
+void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude) {
   const int n = spectrum.rows;
   const int half = n / 2;
-  magnitude.create(n, n);
-  for (int v = 0; v < n; ++v) {
-    const Complex* row = reinterpret_cast<const Complex*>(spectrum.ptr(v));
-    const int centred_row = (v + half) % n;
-    const int mirrored_row = (n + half - v) % n;
-    float* out = magnitude[centred_row];
-    float* out_mirror = magnitude[mirrored_row];
-    const float* h = filter[centred_row];
-    const float* h_mirror = filter[mirrored_row];
-    for (int u = 0; u <= half; ++u) {
-      const float re = row[u].real();
-      const float im = row[u].imag();
-      const float m = std::sqrt(re * re + im * im);
-      const int col = (u + half) % n;
-      const int col_mirror = half - u;
-      out[col] = m * h[col];
-      out_mirror[col_mirror] = m * h_mirror[col_mirror];
+  magnitude.create(half + 2, n);
+  for (int row = 0; row < half + 2; ++row) {
+    // Centred row `row` holds frequency fy = row - N/2; columns with fx >= 0 come from spectrum
+    // row fy mod N, columns with fx < 0 from the conjugate at (-fx, -fy).
+    const int fy = row - half;
+    const Complex* direct = reinterpret_cast<const Complex*>(spectrum.ptr(((fy % n) + n) % n));
+    const Complex* mirror = reinterpret_cast<const Complex*>(spectrum.ptr(((-fy % n) + n) % n));
+    const float* h = filter[row];
+    float* out = magnitude[row];
+    for (int col = half; col < n; ++col) {
+      const Complex v = direct[col - half];
+      out[col] = std::sqrt(v.real() * v.real() + v.imag() * v.imag()) * h[col];
+    }
+    for (int col = 0; col < half; ++col) {
+      const Complex v = mirror[half - col];
+      out[col] = std::sqrt(v.real() * v.real() + v.imag() * v.imag()) * h[col];
     }
   }
 }
@@ -133,7 +121,7 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   frame.invalid_pixels = image.invalid_pixels;
   cv::multiply(frame.grey, context_->window(), windowed_);
   context_->fft().forward(windowed_, frame.spectrum);
-  centredMagnitude(frame.spectrum, context_->highPass(), magnitude_);
+  upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   context_->logPolar(magnitude_, log_polar_);
   context_->fft().forward(log_polar_, frame.log_polar_spectrum);
   return frame;

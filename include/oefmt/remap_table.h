@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Precomputed bilinear resampling (log-polar and polar unwraps): one table lookup and four
+// multiply-adds per output pixel, no per-pixel trigonometry, zero outside the source.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace oefmt {
+
+class BilinearRemapTable {
+ public:
+  /// Maps output pixel (row, col) of an `output`-sized image to the source point
+  /// sample(row, col) = (x, y) of a continuous `source`-sized image (at least 2 x 2).
+  BilinearRemapTable(cv::Size output, cv::Size source,
+                     const std::function<cv::Point2d(int row, int col)>& sample);
+  BilinearRemapTable() = default;
+
+  cv::Size outputSize() const { return output_; }
+  cv::Size sourceSize() const { return source_; }
+
+  /// out (output size) = source resampled.
+  void apply(const cv::Mat1f& source, cv::Mat1f& out) const;
+  /// out (count x output width) = output rows first_row .. first_row + count - 1, taken
+  /// cyclically (row indices wrap around the output height).
+  void applyRows(const cv::Mat1f& source, int first_row, int count, cv::Mat1f& out) const;
+
+ private:
+  struct Tap {
+    std::int32_t offset;  ///< index of the top-left of a 2 x 2 block fully inside the source
+    float weight[4];      ///< top-left, top-right, bottom-left, bottom-right (0 outside)
+  };
+  void applyRow(const float* source, int row, float* out) const;
+
+  cv::Size output_;
+  cv::Size source_;
+  std::vector<Tap> taps_;
+};
+
+}  // namespace oefmt
