@@ -20,8 +20,14 @@ void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Ma
 double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
                          const Fft2d& small, cv::Mat2f& scratch_spectrum, cv::Mat1f& scratch_surface);
 
+/// Sums over a surface, gathered while it is written (for the peak-to-sidelobe ratio).
+struct SurfaceStats {
+  double abs_sum = 0.0;     ///< sum of |v|
+  double square_sum = 0.0;  ///< sum of v^2
+};
+
 /// surface = fftshift(correlation) / N^2: a shift t peaks at (N/2, N/2) + t. Signed values.
-void centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface);
+SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface);
 
 /// Integer peak of |surface| with a sub-pixel refinement.
 struct SurfacePeak {
@@ -40,5 +46,8 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols);
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak. About 15 for unrelated textures at N = 512, hundreds for a clean registration.
 double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak);
+/// The same from sums already gathered by centredSurface.
+double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak,
+                           const SurfaceStats& stats);
 
 }  // namespace oefmt

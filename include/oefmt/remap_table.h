@@ -29,15 +29,15 @@ class BilinearRemapTable {
   void applyRows(const cv::Mat1f& source, int first_row, int count, cv::Mat1f& out) const;
 
  private:
-  struct Tap {
-    std::int32_t offset;  ///< index of the top-left of a 2 x 2 block fully inside the source
-    float weight[4];      ///< top-left, top-right, bottom-left, bottom-right (0 outside)
-  };
   void applyRow(const float* source, int row, float* out) const;
 
   cv::Size output_;
   cv::Size source_;
-  std::vector<Tap> taps_;
+  // One entry per output pixel, structure of arrays for vector loads: the index of the
+  // top-left of a 2 x 2 source block fully inside the source, and the weights of its
+  // top-left, top-right, bottom-left and bottom-right pixels (0 for those outside the source).
+  std::vector<std::int32_t> offset_;
+  std::vector<float> weight_[4];
 };
 
 }  // namespace oefmt

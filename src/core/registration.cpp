@@ -125,7 +125,7 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
   const int n = context_->size();
   normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
   context_->fft().inverse(cross_power_, correlation_);
-  centredSurface(correlation_, surface_);
+  const SurfaceStats stats = centredSurface(correlation_, surface_);
   const SurfacePeak peak = findPeak(surface_, true);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
@@ -147,7 +147,7 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
     result.rotation_sigma = widths.y * CV_PI / n;
     result.log_zoom_sigma = widths.x * log_zoom_per_bin;
   }
-  return peakToSidelobeRatio(surface_, peak);
+  return peakToSidelobeRatio(surface_, peak, stats);
 }
 
 double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
@@ -172,13 +172,13 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   }
   normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_, result.half_turn);
   context_->fft().inverse(cross_power_, correlation_);
-  centredSurface(correlation_, surface_);
+  const SurfaceStats stats = centredSurface(correlation_, surface_);
   const SurfacePeak peak = findPeak(surface_, true);
   result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
   result.direction = std::atan2(result.translation.y, result.translation.x);
   result.shift = std::hypot(result.translation.x, result.translation.y);
   result.translation_peak = peak.value;
-  const double psr = peakToSidelobeRatio(surface_, peak);
+  const double psr = peakToSidelobeRatio(surface_, peak, stats);
 
   if (method == RegistrationMethod::kEnergyVectors) {
     // Polar unwrap: the depths of the scene lie along one direction at different radii (2.6).
