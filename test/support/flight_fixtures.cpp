@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "support/flight_fixtures.h"
+
+#include <cmath>
+#include <mutex>
+
+#include "oefmt/sim/similarity_views.h"
+#include "oefmt/sim/texture.h"
+
+namespace oefmt {
+namespace test {
+namespace {
+
+// Image position, relative to the texture centre, of the ground point (east, north).
+cv::Point2d texturePosition(double east, double north) { return {east, -north}; }
+
+// Turns a y-down vector counter-clockwise on screen by a (the renderer's R).
+cv::Point2d turnOnScreen(const cv::Point2d& v, double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {c * v.x + s * v.y, -s * v.x + c * v.y};
+}
+
+}  // namespace
+
+cv::Mat1f cameraView(const cv::Mat1f& texture, const CameraState& state, int n) {
+  const cv::Point2d centre(texture.cols / 2.0, texture.rows / 2.0);
+  // The camera sees the ground point under it at the image centre; yawing the camera
+  // counter-clockwise turns the content clockwise; climbing shrinks it.
+  sim::ViewMotion motion;
+  motion.rotation = -state.yaw;
+  motion.zoom = 1.0 / state.altitude;
+  motion.shift = turnOnScreen(-texturePosition(state.east, state.north), motion.rotation) * motion.zoom;
+  return sim::renderView(texture, centre, motion, n);
+}
+
+Flight renderFlight(const cv::Mat1f& texture, const std::vector<CameraState>& states, int n) {
+  Flight flight;
+  flight.truth = states;
+  for (const CameraState& s : states) flight.frames.push_back(cameraView(texture, s, n));
+  return flight;
+}
+
+std::vector<CameraState> straightLine(int frames, double east_step, double north_step,
+                                      double yaw_step, double altitude_step) {
+  std::vector<CameraState> states(frames);
+  for (int k = 1; k < frames; ++k) {
+    states[k] = states[k - 1];
+    states[k].east += east_step;
+    states[k].north += north_step;
+    states[k].yaw += yaw_step;
+    states[k].altitude *= altitude_step;
+  }
+  return states;
+}
+
+Flight renderTwoLayerFlight(const cv::Mat1f& ground, const cv::Mat1f& roofs, const cv::Mat1f& mask,
+                            const std::vector<cv::Point2d>& ground_positions,
+                            double roof_speed_ratio, int n) {
+  Flight flight;
+  const cv::Point2d centre(ground.cols / 2.0, ground.rows / 2.0);
+  for (const cv::Point2d& p : ground_positions) {
+    const cv::Point2d ground_shift = -texturePosition(p.x, p.y);
+    flight.frames.push_back(sim::renderTwoLayerView(ground, roofs, mask, centre, ground_shift,
+                                                    ground_shift * roof_speed_ratio, n));
+    CameraState state;
+    state.east = p.x;
+    state.north = p.y;
+    flight.truth.push_back(state);
+  }
+  return flight;
+}
+
+const cv::Mat1f& flightTexture() {
+  static std::once_flag once;
+  static cv::Mat1f texture;
+  std::call_once(once, [] {
+    texture = sim::proceduralTexture(cv::Size(2048, 2048), 31, sim::TextureStyle::kCells, 40.0);
+  });
+  return texture;
+}
+
+}  // namespace test
+}  // namespace oefmt

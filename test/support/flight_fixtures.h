@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Test flights: views of a down-looking camera moving over a flat (or two-layer) textured scene,
+// with the ground truth in the estimator's world conventions.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace oefmt {
+namespace test {
+
+/// A camera state over the texture. east/north are ground distances from the texture centre in
+/// texture pixels (texture x = east, texture y = south); yaw turns the camera counter-clockwise
+/// seen from above; altitude is relative to the first frame's (1 = start). At altitude 1 one
+/// image pixel covers one texture pixel, so fx = altitude_0 = n makes world units texture pixels.
+struct CameraState {
+  double east = 0.0;
+  double north = 0.0;
+  double yaw = 0.0;
+  double altitude = 1.0;
+};
+
+/// The n x n view of the camera at `state`.
+cv::Mat1f cameraView(const cv::Mat1f& texture, const CameraState& state, int n);
+
+struct Flight {
+  std::vector<cv::Mat1f> frames;
+  std::vector<CameraState> truth;
+};
+
+/// Renders one view per state.
+Flight renderFlight(const cv::Mat1f& texture, const std::vector<CameraState>& states, int n);
+
+/// States along a straight line: `steps` steps of (east, north) ground pixels each, starting at
+/// the origin, optionally turning by yaw_step and scaling the altitude by altitude_step per step.
+std::vector<CameraState> straightLine(int frames, double east_step, double north_step,
+                                      double yaw_step = 0.0, double altitude_step = 1.0);
+
+/// A two-depth scene flown at constant heading and altitude: the raised layer (roofs, given by
+/// mask) is nearer to the camera, so its content moves `roof_speed_ratio` times as far as the
+/// ground's. ground_positions are the camera's (east, north) positions in ground pixels.
+Flight renderTwoLayerFlight(const cv::Mat1f& ground, const cv::Mat1f& roofs, const cv::Mat1f& mask,
+                            const std::vector<cv::Point2d>& ground_positions,
+                            double roof_speed_ratio, int n);
+
+/// The scene texture of the flight tests (2048 x 2048, cells, seeded).
+const cv::Mat1f& flightTexture();
+
+}  // namespace test
+}  // namespace oefmt
