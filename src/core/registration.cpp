@@ -26,6 +26,9 @@ constexpr double kPsrGood = 60.0;
 // rows further than 10 from the peak are overruled by the peak row anyway (spec 2.4 step 4b).
 constexpr int kPolarBandHalfWidth = 16;
 constexpr int kEnergyRowBand = 12;
+// Rows of the rotation/zoom surface inverted around the coarse peak: the energy band plus the
+// coarse peak's uncertainty (N / 128 / 2 rows at most).
+constexpr int kRotationBandHalfWidth = kEnergyRowBand + 4;
 
 double wrapAngle(double a) {
   a = std::fmod(a + CV_PI, 2.0 * CV_PI);
@@ -104,7 +107,12 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     return result;
   }
   const double psr_rotation_zoom = registerRotationZoom(older, newer, method, result);
-  if (surfaces != nullptr) surfaces->rotation_zoom = surface_.clone();
+  if (surfaces != nullptr) {
+    // The registration inverts only a band of rows: the full surface costs one more FFT.
+    normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
+    context_->fft().inverse(cross_power_, correlation_);
+    centredSurface(correlation_, surfaces->rotation_zoom);
+  }
   const double psr_translation = registerTranslation(older, newer, method, result);
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
@@ -124,12 +132,20 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
                                      RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
-  context_->fft().inverse(cross_power_, correlation_);
-  const SurfaceStats stats = centredSurface(correlation_, surface_);
+  // Every depth of the scene shares one rotation, so everything of interest lies in a band of
+  // rows around the peak: find it at low resolution, then invert only those rows.
+  const CoarsePeak coarse =
+      lowResolutionPeak(newer.log_polar_spectrum, older.log_polar_spectrum, false,
+                        context_->smallFft(), small_spectrum_, small_surface_);
+  const int band_first_row = n / 2 + coarse.row_shift - kRotationBandHalfWidth;
+  context_->fft().inverseColumns(cross_power_);
+  context_->fft().inverseRows(cross_power_, band_first_row - n / 2, 2 * kRotationBandHalfWidth + 1,
+                              correlation_);
+  const SurfaceStats stats = centredColumns(correlation_, surface_);
   const SurfacePeak peak = findPeak(surface_, true);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
-  result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
+  result.rotation = (band_first_row + peak.sub_row - n / 2) * CV_PI / n;
   result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
   result.rotation_zoom_peak = peak.value;
   if (method == RegistrationMethod::kEnergyVectors) {
@@ -162,9 +178,11 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
     // hypothesis needs no second warp; a low-resolution correlation decides between the two
     // and only the winner gets the full-size inverse FFT.
     const double same = lowResolutionPeak(newer.spectrum, warped_spectrum_, false,
-                                          context_->smallFft(), small_spectrum_, small_surface_);
+                                          context_->smallFft(), small_spectrum_,
+                          small_surface_).value;
     const double turned = lowResolutionPeak(newer.spectrum, warped_spectrum_, true,
-                                            context_->smallFft(), small_spectrum_, small_surface_);
+                                            context_->smallFft(), small_spectrum_,
+                          small_surface_).value;
     if (turned > same) {
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
