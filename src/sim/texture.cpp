@@ -75,5 +75,44 @@ cv::Mat1f proceduralTexture(cv::Size size, std::uint32_t seed, TextureStyle styl
   return texture;
 }
 
+cv::Mat1f makeTileable(const cv::Mat1f& source, int margin) {
+  if (margin < 1 || source.cols <= 2 * margin || source.rows <= 2 * margin) {
+    throw InputError("makeTileable: the source must be larger than twice the margin (>= 1)");
+  }
+  const double mean = cv::mean(source)[0];
+  // Columns first (keeping all rows), then rows of that result.
+  const int width = source.cols - margin, height = source.rows - margin;
+  cv::Mat1f columns(source.rows, width);
+  for (int r = 0; r < source.rows; ++r) {
+    const float* in = source[r];
+    float* out = columns[r];
+    for (int c = 0; c < width; ++c) out[c] = in[c];
+    for (int c = 0; c < margin; ++c) {
+      // Position c continues the source's column `width + c`: fade from that one into column c.
+      const double w = (c + 0.5) / margin * (CV_PI / 2.0);
+      out[c] = static_cast<float>(mean + std::sin(w) * (in[c] - mean) + std::cos(w) * (in[width + c] - mean));
+    }
+  }
+  cv::Mat1f tile = columns.rowRange(0, height).clone();
+  for (int r = 0; r < margin; ++r) {
+    const double w = (r + 0.5) / margin * (CV_PI / 2.0);
+    const float* near_row = columns[r];
+    const float* far_row = columns[height + r];
+    float* out = tile[r];
+    for (int c = 0; c < width; ++c) {
+      out[c] = static_cast<float>(mean + std::sin(w) * (near_row[c] - mean) + std::cos(w) * (far_row[c] - mean));
+    }
+  }
+  return tile;
+}
+
+cv::Mat1f tileableTexture(int size, std::uint32_t seed, TextureStyle style, double feature_px) {
+  const int margin = std::max(4, size / 8);
+  cv::Mat1f tile = makeTileable(proceduralTexture(cv::Size(size + margin, size + margin), seed, style, feature_px),
+                                margin);
+  cv::normalize(tile, tile, 0.0, 1.0, cv::NORM_MINMAX);
+  return tile;
+}
+
 }  // namespace sim
 }  // namespace oefmt

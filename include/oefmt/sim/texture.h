@@ -20,5 +20,14 @@ enum class TextureStyle {
 cv::Mat1f proceduralTexture(cv::Size size, std::uint32_t seed,
                             TextureStyle style = TextureStyle::kCells, double feature_px = 48.0);
 
+/// Makes `source` periodic without a seam: the last `margin` columns and rows are cross-faded into
+/// the first ones (weights that keep the variance of independent noise). The result is
+/// (width - margin) x (height - margin) and tiles seamlessly. Throws InputError when margin < 1
+/// or the source is not larger than 2 * margin.
+cv::Mat1f makeTileable(const cv::Mat1f& source, int margin);
+
+/// A size x size proceduralTexture that tiles seamlessly (made from a larger one by makeTileable).
+cv::Mat1f tileableTexture(int size, std::uint32_t seed, TextureStyle style, double feature_px);
+
 }  // namespace sim
 }  // namespace oefmt

@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Trajectory evaluation: TUM files, association, similarity alignment (Umeyama), absolute
+// trajectory error, drift per distance travelled and loop error.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace oefmt {
+
+/// One pose of a trajectory: time [s], position [m], orientation (body to world).
+struct StampedPose {
+  double stamp = 0.0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+};
+using Trajectory = std::vector<StampedPose>;
+
+/// Reads a TUM file (`t x y z qx qy qz qw` per line; '#' comments and blank lines skipped;
+/// commas are accepted as separators). Throws DatasetError naming the file and line.
+Trajectory readTum(const std::string& path);
+
+/// Writes a TUM file; `header` lines are written first, each prefixed with "# ".
+/// Throws DatasetError when the file cannot be written.
+void writeTum(const std::string& path, const Trajectory& trajectory,
+              const std::vector<std::string>& header = {});
+
+/// Pairs (estimate index, ground-truth index).
+using Association = std::vector<std::pair<std::size_t, std::size_t>>;
+
+/// Matches each estimated pose with the ground-truth pose nearest in time, if within `tolerance`
+/// seconds; each ground-truth pose is used at most once. Both trajectories must be time-ordered.
+Association associateByTime(const Trajectory& estimate, const Trajectory& truth, double tolerance);
+
+/// Matches pose k with pose k for k < min(sizes).
+Association associateByIndex(const Trajectory& estimate, const Trajectory& truth);
+
+/// x -> scale * rotation * x + translation.
+struct Similarity {
+  double scale = 1.0;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d apply(const Eigen::Vector3d& p) const { return scale * (rotation * p) + translation; }
+  /// The yaw of the rotation (about z) [rad].
+  double yaw() const;
+};
+
+/// Least-squares alignment of `source` onto `target` (Umeyama). planar: rotation about z, scale
+/// and x-y translation fitted to x-y only, z then shifted so the mean heights agree; otherwise a
+/// full 3-D fit. with_scale false fixes scale at 1 (rigid). Throws InputError with fewer than 2
+/// pairs, mismatched sizes, or source points that all coincide.
+Similarity alignTrajectories(const std::vector<Eigen::Vector3d>& source,
+                             const std::vector<Eigen::Vector3d>& target, bool planar, bool with_scale);
+
+struct ErrorStatistics {
+  std::size_t count = 0;
+  double rmse = 0.0;
+  double mean = 0.0;
+  double median = 0.0;
+  double max = 0.0;
+};
+ErrorStatistics errorStatistics(std::vector<double> errors);
+
+enum class AssociationMode { kTimestamp, kIndex };
+
+struct EvaluationOptions {
+  AssociationMode association = AssociationMode::kTimestamp;
+  double time_tolerance = 0.02;    ///< [s], timestamp association only
+  bool planar = true;              ///< align and measure in x-y (false: 3-D)
+  bool with_scale = true;          ///< similarity (true) or rigid (false) alignment
+  /// Segment lengths for the drift, as fractions of the ground truth's path length.
+  std::vector<double> drift_segment_fractions = {0.1, 0.2, 0.3, 0.4, 0.5};
+};
+
+/// Relative error over segments of one length.
+struct DriftSegment {
+  double length = 0.0;         ///< [m] of ground-truth path
+  std::size_t count = 0;       ///< segments measured
+  double mean_percent = 0.0;   ///< mean |displacement error| / length * 100
+};
+
+struct EvaluationResult {
+  std::size_t estimate_poses = 0;
+  std::size_t truth_poses = 0;
+  std::size_t matched = 0;
+  Similarity alignment;                ///< estimate -> ground truth
+  ErrorStatistics ate;                 ///< absolute trajectory error after alignment [m]
+  std::vector<double> errors;          ///< per matched pose [m]
+  double path_length = 0.0;            ///< ground truth, over the matched poses [m]
+  std::vector<DriftSegment> drift;     ///< per segment length
+  double drift_percent = 0.0;          ///< mean over all segments of all lengths [%]
+  /// |(est_last - est_first) - (gt_last - gt_first)| after alignment [m]: for a closed loop, the
+  /// gap the estimate leaves where the truth closes.
+  double loop_error = 0.0;
+  double loop_error_percent = 0.0;     ///< loop_error / path_length * 100
+  Trajectory aligned_estimate;         ///< matched estimate poses after alignment
+  Trajectory matched_truth;            ///< their ground-truth poses
+};
+
+/// Associates, aligns and measures. Throws InputError when too few poses match.
+EvaluationResult evaluateTrajectory(const Trajectory& estimate, const Trajectory& truth,
+                                    const EvaluationOptions& options);
+
+/// One line of JSON with every figure of the result (no per-pose data).
+std::string evaluationJson(const EvaluationResult& result, const EvaluationOptions& options);
+
+/// A human-readable table of the result.
+std::string evaluationTable(const EvaluationResult& result, const EvaluationOptions& options);
+
+}  // namespace oefmt

@@ -1,0 +1,284 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/dataset.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "oefmt/error.h"
+
+namespace oefmt {
+namespace fs = std::filesystem;
+namespace {
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return "";
+  const auto last = text.find_last_not_of(" \t\r\n");
+  return text.substr(first, last - first + 1);
+}
+
+// Non-blank, non-comment lines of a text file, trimmed (CR LF and a missing final newline are fine).
+std::vector<std::string> readLines(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw DatasetError("cannot open '" + path + "'");
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    line = trim(line);
+    if (!line.empty() && line[0] != '#') lines.push_back(line);
+  }
+  return lines;
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw DatasetError("cannot open camera parameters '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Reads Camera.<key> as a number; `fallback` when absent and not required.
+double readNumber(const cv::FileStorage& storage, const std::string& path, const char* key,
+                  bool required, double fallback) {
+  const cv::FileNode node = storage[std::string("Camera.") + key];
+  if (node.empty() || node.isNone()) {
+    if (required) throw DatasetError("'" + path + "' has no Camera." + key);
+    return fallback;
+  }
+  if (!node.isReal() && !node.isInt()) {
+    throw DatasetError("'" + path + "': Camera." + key + " is not a number");
+  }
+  const double value = static_cast<double>(node);
+  if (!std::isfinite(value)) throw DatasetError("'" + path + "': Camera." + key + " is not finite");
+  return value;
+}
+
+bool isImageFile(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" ||
+         ext == ".bmp";
+}
+
+std::string sizeText(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+}  // namespace
+
+CameraParameters readCameraParameters(const std::string& path) {
+  std::string text = readWholeFile(path);
+  // OpenCV's parser wants the %YAML directive and a final newline; users' files may lack both.
+  if (text.rfind("%YAML", 0) != 0) text = "%YAML:1.0\n" + text;
+  text += "\n";
+  cv::FileStorage storage;
+  try {
+    storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    throw DatasetError("cannot parse camera parameters '" + path + "': " + e.err);
+  }
+  if (!storage.isOpened()) throw DatasetError("cannot parse camera parameters '" + path + "'");
+  CameraParameters camera;
+  Intrinsics& k = camera.intrinsics;
+  k.fx = readNumber(storage, path, "fx", true, 0.0);
+  k.fy = readNumber(storage, path, "fy", true, 0.0);
+  k.cx = readNumber(storage, path, "cx", true, 0.0);
+  k.cy = readNumber(storage, path, "cy", true, 0.0);
+  k.width = static_cast<int>(std::lround(readNumber(storage, path, "width", false, 0.0)));
+  k.height = static_cast<int>(std::lround(readNumber(storage, path, "height", false, 0.0)));
+  if (!(k.fx > 0.0 && k.fy > 0.0)) throw DatasetError("'" + path + "': Camera.fx and fy must be > 0");
+  if (k.width < 0 || k.height < 0) throw DatasetError("'" + path + "': negative Camera.width/height");
+  Distortion& d = camera.distortion;
+  d.k1 = readNumber(storage, path, "k1", false, 0.0);
+  d.k2 = readNumber(storage, path, "k2", false, 0.0);
+  d.p1 = readNumber(storage, path, "p1", false, 0.0);
+  d.p2 = readNumber(storage, path, "p2", false, 0.0);
+  return camera;
+}
+
+void writeCameraParameters(const std::string& path, const CameraParameters& camera) {
+  const Intrinsics& k = camera.intrinsics;
+  const Distortion& d = camera.distortion;
+  std::ofstream out(path);
+  if (!out) throw DatasetError("cannot write camera parameters '" + path + "'");
+  out.precision(10);
+  out << "%YAML:1.0\n\nCamera.type: \"PinHole\"\n\n"
+      << "Camera.fx: " << k.fx << "\nCamera.fy: " << k.fy << "\nCamera.cx: " << k.cx
+      << "\nCamera.cy: " << k.cy << "\n\nCamera.k1: " << d.k1 << "\nCamera.k2: " << d.k2
+      << "\nCamera.p1: " << d.p1 << "\nCamera.p2: " << d.p2 << "\n\nCamera.width: " << k.width
+      << "\nCamera.height: " << k.height << "\n";
+  if (!out) throw DatasetError("cannot write camera parameters '" + path + "'");
+}
+
+Intrinsics intrinsicsForImageSize(const Intrinsics& camera, cv::Size image_size) {
+  if (!camera.valid()) throw InputError("camera intrinsics are invalid (fx, fy, width, height must be > 0)");
+  if (image_size.width <= 0 || image_size.height <= 0) throw InputError("image size must be > 0");
+  // Largest centred region of the camera image with the image's aspect ratio.
+  const double aspect = static_cast<double>(image_size.width) / image_size.height;
+  double crop_w = camera.width, crop_h = camera.height;
+  if (crop_w / crop_h > aspect) {
+    crop_w = crop_h * aspect;
+  } else {
+    crop_h = crop_w / aspect;
+  }
+  const double x0 = (camera.width - crop_w) / 2.0;
+  const double y0 = (camera.height - crop_h) / 2.0;
+  const double kx = image_size.width / crop_w;
+  const double ky = image_size.height / crop_h;
+  Intrinsics out;
+  out.fx = camera.fx * kx;
+  out.fy = camera.fy * ky;
+  out.cx = (camera.cx - x0 + 0.5) * kx - 0.5;
+  out.cy = (camera.cy - y0 + 0.5) * ky - 0.5;
+  out.width = image_size.width;
+  out.height = image_size.height;
+  return out;
+}
+
+bool parseTimestamp(const std::string& raw, double& seconds) {
+  const std::string text = trim(raw);
+  if (text.empty()) return false;
+  const bool all_digits = std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isdigit(c); });
+  if (all_digits && text.size() == 14) {
+    std::tm tm{};
+    tm.tm_year = std::stoi(text.substr(0, 4)) - 1900;
+    tm.tm_mon = std::stoi(text.substr(4, 2)) - 1;
+    tm.tm_mday = std::stoi(text.substr(6, 2));
+    tm.tm_hour = std::stoi(text.substr(8, 2));
+    tm.tm_min = std::stoi(text.substr(10, 2));
+    tm.tm_sec = std::stoi(text.substr(12, 2));
+    if (tm.tm_mon < 0 || tm.tm_mon > 11 || tm.tm_mday < 1 || tm.tm_mday > 31 || tm.tm_hour > 23 ||
+        tm.tm_min > 59 || tm.tm_sec > 60) {
+      return false;
+    }
+    seconds = static_cast<double>(timegm(&tm));
+    return true;
+  }
+  std::size_t used = 0;
+  try {
+    seconds = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return used == text.size() && std::isfinite(seconds);
+}
+
+FolderDataset::FolderDataset(const std::string& directory) : directory_(directory) {
+  if (!fs::is_directory(directory_)) throw DatasetError("dataset folder '" + directory_ + "' does not exist");
+  readImageList();
+  if (names_.empty()) throw DatasetError("dataset '" + directory_ + "' lists no image");
+
+  const cv::Mat first = cv::imread(paths_[0], cv::IMREAD_UNCHANGED);
+  if (first.empty()) {
+    throw DatasetError(fs::exists(paths_[0]) ? "cannot read image '" + paths_[0] + "' (not an image?)"
+                                             : "image '" + paths_[0] + "' does not exist");
+  }
+  image_size_ = first.size();
+
+  const std::string yaml = (fs::path(directory_) / "cam_param.yaml").string();
+  if (!fs::exists(yaml)) throw DatasetError("dataset '" + directory_ + "' has no cam_param.yaml");
+  camera_ = readCameraParameters(yaml);
+  file_intrinsics_ = camera_.intrinsics;
+  if (file_intrinsics_.width <= 0 || file_intrinsics_.height <= 0) {
+    warnings_.push_back("cam_param.yaml gives no Camera.width/height: taken as the image size " +
+                        sizeText(image_size_));
+    file_intrinsics_.width = image_size_.width;
+    file_intrinsics_.height = image_size_.height;
+  }
+  camera_.intrinsics = intrinsicsForImageSize(file_intrinsics_, image_size_);
+  readTimestamps();
+}
+
+void FolderDataset::readImageList() {
+  const fs::path root(directory_);
+  const fs::path list = root / "imageList.txt";
+  const fs::path images = root / "Images";
+  if (fs::exists(list)) {
+    names_ = readLines(list.string());
+    for (const std::string& name : names_) {
+      const fs::path in_images = images / name;
+      paths_.push_back((fs::exists(in_images) || !fs::exists(root / name) ? in_images : root / name).string());
+    }
+    return;
+  }
+  if (!fs::is_directory(images)) {
+    throw DatasetError("dataset '" + directory_ + "' has neither imageList.txt nor an Images folder");
+  }
+  warnings_.push_back("no imageList.txt: using every image in Images/ in name order");
+  for (const auto& entry : fs::directory_iterator(images)) {
+    if (entry.is_regular_file() && isImageFile(entry.path())) names_.push_back(entry.path().filename().string());
+  }
+  std::sort(names_.begin(), names_.end());
+  for (const std::string& name : names_) paths_.push_back((images / name).string());
+}
+
+void FolderDataset::readTimestamps() {
+  const fs::path file = fs::path(directory_) / "timestamps.txt";
+  if (!fs::exists(file)) return;
+  const std::vector<std::string> lines = readLines(file.string());
+  const std::string ignored = "timestamps.txt ignored (frame k gets timestamp k): ";
+  if (lines.size() != names_.size()) {
+    warnings_.push_back(ignored + "it has " + std::to_string(lines.size()) + " stamps for " +
+                        std::to_string(names_.size()) + " images");
+    return;
+  }
+  std::vector<double> stamps(lines.size());
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (!parseTimestamp(lines[i], stamps[i])) {
+      warnings_.push_back(ignored + "line " + std::to_string(i + 1) + " '" + lines[i] + "' is not a time");
+      return;
+    }
+    if (i > 0 && !(stamps[i] > stamps[i - 1])) {
+      warnings_.push_back(ignored + "stamps do not increase at line " + std::to_string(i + 1));
+      return;
+    }
+  }
+  timestamps_ = std::move(stamps);
+  has_timestamps_ = true;
+}
+
+void FolderDataset::checkIndex(std::size_t index) const {
+  if (index >= names_.size()) {
+    throw InputError("frame " + std::to_string(index) + " is out of range (dataset has " +
+                     std::to_string(names_.size()) + " images)");
+  }
+}
+
+const std::string& FolderDataset::imageName(std::size_t index) const {
+  checkIndex(index);
+  return names_[index];
+}
+
+const std::string& FolderDataset::imagePath(std::size_t index) const {
+  checkIndex(index);
+  return paths_[index];
+}
+
+double FolderDataset::timestamp(std::size_t index) const {
+  checkIndex(index);
+  return has_timestamps_ ? timestamps_[index] : static_cast<double>(index);
+}
+
+cv::Mat FolderDataset::loadImage(std::size_t index) const {
+  const std::string& path = imagePath(index);
+  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty()) {
+    throw DatasetError(fs::exists(path) ? "cannot read image '" + path + "' (not an image or corrupt)"
+                                        : "image '" + path + "' does not exist");
+  }
+  if (image.size() != image_size_) {
+    throw DatasetError("image '" + path + "' is " + sizeText(image.size()) + " but the dataset's images are " +
+                       sizeText(image_size_));
+  }
+  return image;
+}
+
+}  // namespace oefmt

@@ -1,0 +1,167 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/sim/flight.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "oefmt/error.h"
+#include "oefmt/sim/renderer.h"
+
+namespace oefmt {
+namespace sim {
+namespace {
+
+CameraParameters resolveCamera(const FlightOptions& o) {
+  if (o.width < 16 || o.height < 16) throw InputError("image size must be at least 16 x 16 px");
+  CameraParameters camera;
+  Intrinsics& k = camera.intrinsics;
+  k.width = o.width;
+  k.height = o.height;
+  k.fx = o.fx > 0.0 ? o.fx : o.width / (2.0 * std::tan(CV_PI / 6.0));
+  k.fy = o.fy > 0.0 ? o.fy : k.fx;
+  k.cx = o.cx >= 0.0 ? o.cx : (o.width - 1) / 2.0;
+  k.cy = o.cy >= 0.0 ? o.cy : (o.height - 1) / 2.0;
+  if (!std::isfinite(k.fx) || !std::isfinite(k.fy) || !std::isfinite(k.cx) || !std::isfinite(k.cy)) {
+    throw InputError("intrinsics must be finite");
+  }
+  camera.distortion = o.distortion;
+  return camera;
+}
+
+// Mean consecutive ground overlap of the track flown at `altitude`.
+double meanOverlapAt(const CameraParameters& camera, TrackConfig track, double altitude) {
+  track.altitude = altitude;
+  return consecutiveOverlap(camera, makeTrack(track), 0.0).mean;
+}
+
+// The altitude at which consecutive frames overlap `target` on average (overlap grows with
+// altitude, so bisection).
+double altitudeForOverlap(const CameraParameters& camera, const TrackConfig& track, double target) {
+  if (!(target > 0.0 && target < 1.0)) throw InputError("overlap must be in (0, 1)");
+  const double step = frameSpacing(track);
+  double low = std::max(step * 1e-3, 1e-3 - std::min(0.0, track.climb));
+  double high = step * 1e4 + std::max(0.0, -track.climb);
+  for (int iteration = 0; iteration < 80; ++iteration) {
+    const double middle = 0.5 * (low + high);
+    (meanOverlapAt(camera, track, middle) < target ? low : high) = middle;
+  }
+  return 0.5 * (low + high);
+}
+
+}  // namespace
+
+FlightPlan planFlight(const FlightOptions& o) {
+  FlightPlan plan;
+  plan.camera = resolveCamera(o);
+  const Intrinsics& k = plan.camera.intrinsics;
+  plan.track = o.track;
+  if (!(plan.track.altitude > 0.0)) {
+    plan.track.altitude = 1.0;  // validated below with the real value
+    plan.track.validate();
+    plan.track.altitude = altitudeForOverlap(plan.camera, plan.track, o.overlap);
+  }
+  plan.poses = makeTrack(plan.track);
+  const double altitude = plan.track.altitude;
+  const double ground_pixel = altitude / k.fx;  // [m] at the start altitude
+
+  SceneConfig& scene = plan.scene;
+  scene.seed = o.seed;
+  std::vector<double> heights = o.level_heights;
+  if (heights.empty()) heights = {0.15 * altitude, 0.30 * altitude};
+  scene.levels.clear();
+  for (std::size_t l = 0; l < heights.size(); ++l) {
+    BlockLevel level;
+    level.height = heights[l];
+    level.incline_deg = l + 1 == heights.size() ? o.incline_deg : 0.0;
+    level.share = 0.7 / heights.size();
+    scene.levels.push_back(level);
+  }
+  scene.cell_size = o.cell_size > 0.0 ? o.cell_size : 0.22 * ground_pixel * k.width;
+  scene.texel = o.texel > 0.0 ? o.texel : 0.5 * ground_pixel;
+  scene.texture_size = o.texture_size > 0 ? o.texture_size : std::min(4096, 8 * k.width);
+  scene.feature_texels = std::max(2.0, scene.texture_size / 40.0);
+  scene.texture_files = o.texture_files;
+  // Everything the camera sees lies inside the union of the ground footprints.
+  double x_min = HUGE_VAL, y_min = HUGE_VAL, x_max = -HUGE_VAL, y_max = -HUGE_VAL;
+  for (const FlightPose& pose : plan.poses) {
+    for (const cv::Point2f& corner : groundFootprint(plan.camera, pose, 0.0)) {
+      x_min = std::min(x_min, static_cast<double>(corner.x));
+      x_max = std::max(x_max, static_cast<double>(corner.x));
+      y_min = std::min(y_min, static_cast<double>(corner.y));
+      y_max = std::max(y_max, static_cast<double>(corner.y));
+    }
+  }
+  const cv::Rect2d region(x_min, y_min, x_max - x_min, y_max - y_min);
+  scene.region = region;
+  scene.validate();
+
+  if (o.supersample < 1 || o.supersample > 8) throw InputError("supersample must be in [1, 8]");
+  plan.supersample = o.supersample;
+  if (!(o.sensor.noise >= 0.0) || !(o.sensor.brightness >= 0.0 && o.sensor.brightness < 1.0) ||
+      !(o.sensor.brightness_period > 0.0)) {
+    throw InputError("sensor: noise must be >= 0, brightness in [0, 1), brightness period > 0");
+  }
+  plan.sensor = o.sensor;
+  if (!(o.rate > 0.0) || !(o.start_time > 0.0) || !std::isfinite(o.start_time)) {
+    throw InputError("rate and start time must be > 0");
+  }
+  for (std::size_t i = 0; i < plan.poses.size(); ++i) plan.stamps.push_back(o.start_time + i / o.rate);
+
+  const double top = scene.highestTop();
+  double lowest = plan.poses.front().position[2];
+  for (const FlightPose& pose : plan.poses) lowest = std::min(lowest, pose.position[2]);
+  if (!(lowest > top)) {
+    throw InputError("the flight's lowest altitude (" + std::to_string(lowest) +
+                     " m) must be above the highest block top (" + std::to_string(top) + " m)");
+  }
+  plan.ground_overlap = consecutiveOverlap(plan.camera, plan.poses, 0.0);
+  double highest_level = 0.0;
+  for (const BlockLevel& level : scene.levels) highest_level = std::max(highest_level, level.height);
+  plan.top_overlap = consecutiveOverlap(plan.camera, plan.poses, highest_level);
+  return plan;
+}
+
+double frameGain(const SensorOptions& sensor, int frame) {
+  return 1.0 + sensor.brightness * std::sin(2.0 * CV_PI * frame / sensor.brightness_period);
+}
+
+cv::Mat1b sensorImage(const cv::Mat1f& rendered, const SensorOptions& sensor, std::uint32_t seed, int frame) {
+  cv::Mat1f image = rendered * frameGain(sensor, frame);
+  if (sensor.noise > 0.0) {
+    cv::RNG rng((static_cast<std::uint64_t>(seed) << 32) ^ (0x5DEECE66DULL + static_cast<std::uint64_t>(frame)));
+    cv::Mat1f noise(image.size());
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, sensor.noise);
+    image += noise;
+  }
+  cv::Mat1b out;
+  image.convertTo(out, CV_8U, 255.0);  // rounds and saturates
+  return out;
+}
+
+void renderFlight(const FlightPlan& plan, const FrameSink& sink) {
+  const auto scene = std::make_shared<const Scene>(plan.scene);
+  const Renderer renderer(scene, plan.camera, plan.supersample);
+  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
+    const RenderedFrame frame = renderer.render(plan.poses[k]);
+    sink(static_cast<int>(k), sensorImage(frame.image, plan.sensor, plan.scene.seed, static_cast<int>(k)),
+         frame.layers);
+  }
+}
+
+std::vector<std::string> groundTruthHeader(const FlightPlan& plan) {
+  return {
+      "oefmt_simulate ground truth, one line per frame: t x y z qx qy qz qw",
+      "t: seconds (same stamps as timestamps.txt and the bag); x y z: metres",
+      "world frame (REP-103, ENU): x east, y north, z up; ground plane at z = 0",
+      "pose of the camera body (base_link): position and yaw about z (roll = pitch = 0)",
+      "the camera looks straight down: base_link -> camera optical frame is a 180 deg turn about x",
+      "(quaternion x=1 y=0 z=0 w=0), so at yaw 0 image right = +x (east), image up = +y (north)",
+      std::string("track ") + toString(plan.track.shape) + ", " + std::to_string(plan.poses.size()) +
+          " frames, length " + std::to_string(plan.track.length) + " m, altitude " +
+          std::to_string(plan.track.altitude) + " m, climb " + std::to_string(plan.track.climb) + " m",
+  };
+}
+
+}  // namespace sim
+}  // namespace oefmt

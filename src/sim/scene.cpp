@@ -1,0 +1,281 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/sim/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "oefmt/dataset.h"
+#include "oefmt/error.h"
+#include "oefmt/image_prep.h"
+#include "oefmt/sim/texture.h"
+
+namespace oefmt {
+namespace sim {
+namespace {
+
+// splitmix64's finaliser: a well-mixed 64-bit hash, the same on every machine.
+std::uint64_t mix(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+// [0, 1) from the top 53 bits.
+double unit(std::uint64_t h) { return static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0); }
+
+enum Purpose : std::uint64_t { kTerraceLevel = 1, kTerraceAzimuth = 2, kCellFilled = 3 };
+constexpr int kDirections = 256;
+
+long long floorIndex(double value) { return static_cast<long long>(std::floor(value)); }
+
+cv::Mat1f textureFromFile(const std::string& path) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (image.empty()) throw DatasetError("cannot read texture image '" + path + "'");
+  cv::Mat1f grey = toGreyFloat(image);
+  const int margin = std::max(4, std::min(grey.cols, grey.rows) / 8);
+  if (grey.cols <= 2 * margin + 8 || grey.rows <= 2 * margin + 8) {
+    throw InputError("texture image '" + path + "' is too small");
+  }
+  cv::Mat1f tile = makeTileable(grey, margin);
+  cv::normalize(tile, tile, 0.0, 1.0, cv::NORM_MINMAX);
+  return tile;
+}
+
+}  // namespace
+
+void SceneConfig::validate() const {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError("scene: " + what);
+  };
+  require(cell_size > 0.0 && std::isfinite(cell_size), "cell_size must be > 0");
+  require(terrace_cells >= 1, "terrace_cells must be >= 1");
+  require(gap >= 0.0 && gap < 0.5, "gap must be in [0, 0.5)");
+  require(fill >= 0.0 && fill <= 1.0, "fill must be in [0, 1]");
+  require(texel > 0.0 && std::isfinite(texel), "texel must be > 0");
+  require(texture_size >= 64, "texture_size must be >= 64");
+  require(feature_texels >= 2.0, "feature_texels must be >= 2");
+  double shares = 0.0;
+  for (const BlockLevel& level : levels) {
+    require(level.height > 0.0 && std::isfinite(level.height), "level heights must be > 0");
+    require(level.incline_deg >= 0.0 && level.incline_deg < 45.0, "level inclines must be in [0, 45) deg");
+    require(level.share >= 0.0, "level shares must be >= 0");
+    shares += level.share;
+  }
+  require(shares <= 1.0 + 1e-9, "the levels' shares must add up to at most 1");
+}
+
+double SceneConfig::levelReach(const BlockLevel& level) const {
+  const double terrace_half_diagonal = cell_size * terrace_cells * std::sqrt(0.5);
+  return std::tan(level.incline_deg * CV_PI / 180.0) * terrace_half_diagonal;
+}
+
+double SceneConfig::highestTop() const {
+  double top = 0.0;
+  for (const BlockLevel& level : levels) top = std::max(top, level.height + levelReach(level));
+  return top;
+}
+
+Scene::Scene(const SceneConfig& config)
+    : config_(config), seed_hash_(mix(config.seed)), terrace_side_(config.cell_size * config.terrace_cells) {
+  config_.validate();
+  const TextureStyle styles[] = {TextureStyle::kCells, TextureStyle::kStripes, TextureStyle::kNoise};
+  const int layers = static_cast<int>(config_.levels.size()) + 1;
+  textures_.resize(layers);
+  // Layers in parallel: the textures are the slowest part of setting up a flight.
+  cv::parallel_for_(cv::Range(0, layers), [&](const cv::Range& range) {
+    for (int layer = range.start; layer < range.end; ++layer) {
+      const bool from_file = layer < static_cast<int>(config_.texture_files.size()) &&
+                             !config_.texture_files[layer].empty();
+      const int size = layer == 0 ? config_.texture_size : std::max(64, config_.texture_size / 2);
+      const TextureStyle style = styles[layer % 3];
+      // Plain noise is smooth at the coarse scale: finer structures keep it rich in detail.
+      const double feature = style == TextureStyle::kNoise ? std::max(2.0, config_.feature_texels / 4.0)
+                                                            : config_.feature_texels;
+      textures_[layer] = from_file ? textureFromFile(config_.texture_files[layer])
+                                   : tileableTexture(size, config_.seed * 7919u + layer, style, feature);
+    }
+  });
+  double bound = 0.0;
+  for (const BlockLevel& level : config_.levels) {
+    level_reach_.push_back(config_.levelReach(level));
+    level_slope_.push_back(std::tan(level.incline_deg * CV_PI / 180.0));
+    bound += level.share;
+    share_bounds_.push_back(bound);
+  }
+  for (int k = 0; k < kDirections; ++k) {
+    const double azimuth = 2.0 * CV_PI * (k + 0.5) / kDirections;
+    directions_.emplace_back(std::cos(azimuth), std::sin(azimuth));
+  }
+  tabulate();
+}
+
+std::uint64_t Scene::hash(long long i, long long j, std::uint64_t purpose) const {
+  return mix(seed_hash_ ^ mix(static_cast<std::uint64_t>(i) * 0xD1B54A32D192ED03ULL ^
+                              static_cast<std::uint64_t>(j) * 0xABC98388FB8FAC03ULL ^ purpose));
+}
+
+int Scene::computeTerraceLevel(long long ti, long long tj) const {
+  const double u = unit(hash(ti, tj, kTerraceLevel));
+  for (std::size_t l = 0; l < share_bounds_.size(); ++l) {
+    if (u < share_bounds_[l]) return static_cast<int>(l);
+  }
+  return -1;
+}
+
+int Scene::computeCellCode(long long ci, long long cj) const {
+  if (unit(hash(ci, cj, kCellFilled)) >= config_.fill) return 0;
+  return computeTerraceLevel(floorIndex(static_cast<double>(ci) / config_.terrace_cells),
+                             floorIndex(static_cast<double>(cj) / config_.terrace_cells)) + 1;
+}
+
+void Scene::tabulate() {
+  const cv::Rect2d& r = config_.region;
+  if (!(r.width > 0.0 && r.height > 0.0)) return;
+  Layout& t = layout_;
+  const double cells = (r.width / config_.cell_size + 3.0) * (r.height / config_.cell_size + 3.0);
+  if (!(cells < 64e6)) return;  // too large to be worth it: compute on the fly
+  t.cell_i0 = floorIndex(r.x / config_.cell_size) - 1;
+  t.cell_j0 = floorIndex(r.y / config_.cell_size) - 1;
+  t.cell_cols = static_cast<int>(floorIndex((r.x + r.width) / config_.cell_size) + 2 - t.cell_i0);
+  t.cell_rows = static_cast<int>(floorIndex((r.y + r.height) / config_.cell_size) + 2 - t.cell_j0);
+  t.cell_code.resize(static_cast<std::size_t>(t.cell_cols) * t.cell_rows);
+  for (int j = 0; j < t.cell_rows; ++j) {
+    for (int i = 0; i < t.cell_cols; ++i) {
+      t.cell_code[static_cast<std::size_t>(j) * t.cell_cols + i] =
+          static_cast<signed char>(computeCellCode(t.cell_i0 + i, t.cell_j0 + j));
+    }
+  }
+  t.terrace_i0 = floorIndex(r.x / terrace_side_) - 1;
+  t.terrace_j0 = floorIndex(r.y / terrace_side_) - 1;
+  t.terrace_cols = static_cast<int>(floorIndex((r.x + r.width) / terrace_side_) + 2 - t.terrace_i0);
+  t.terrace_rows = static_cast<int>(floorIndex((r.y + r.height) / terrace_side_) + 2 - t.terrace_j0);
+  for (int j = 0; j < t.terrace_rows; ++j) {
+    for (int i = 0; i < t.terrace_cols; ++i) {
+      t.terrace_level.push_back(static_cast<signed char>(computeTerraceLevel(t.terrace_i0 + i, t.terrace_j0 + j)));
+      t.terrace_direction.push_back(
+          static_cast<unsigned char>(hash(t.terrace_i0 + i, t.terrace_j0 + j, kTerraceAzimuth) % kDirections));
+    }
+  }
+}
+
+int Scene::terraceLevel(long long ti, long long tj) const {
+  const long long i = ti - layout_.terrace_i0, j = tj - layout_.terrace_j0;
+  if (i >= 0 && j >= 0 && i < layout_.terrace_cols && j < layout_.terrace_rows) {
+    return layout_.terrace_level[static_cast<std::size_t>(j) * layout_.terrace_cols + i];
+  }
+  return computeTerraceLevel(ti, tj);
+}
+
+cv::Vec2d Scene::terraceSlope(long long ti, long long tj, int level) const {
+  if (level_slope_[level] == 0.0) return {0.0, 0.0};
+  const long long i = ti - layout_.terrace_i0, j = tj - layout_.terrace_j0;
+  const bool tabulated = i >= 0 && j >= 0 && i < layout_.terrace_cols && j < layout_.terrace_rows;
+  const std::size_t direction = tabulated ? layout_.terrace_direction[static_cast<std::size_t>(j) * layout_.terrace_cols + i]
+                                          : hash(ti, tj, kTerraceAzimuth) % kDirections;
+  return level_slope_[level] * directions_[direction];
+}
+
+int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
+  const double cx = x / config_.cell_size, cy = y / config_.cell_size;
+  const double fci = std::floor(cx), fcj = std::floor(cy);
+  const double fx = cx - fci, fy = cy - fcj;
+  if (fx < config_.gap || fx > 1.0 - config_.gap || fy < config_.gap || fy > 1.0 - config_.gap) return 0;
+  const long long ci = static_cast<long long>(fci), cj = static_cast<long long>(fcj);
+  *ti = floorIndex(fci / config_.terrace_cells);
+  *tj = floorIndex(fcj / config_.terrace_cells);
+  const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
+  if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
+    return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
+  }
+  return computeCellCode(ci, cj);
+}
+
+int Scene::layerAt(double x, double y, double* height) const {
+  long long ti = 0, tj = 0;
+  const int code = topAt(x, y, &ti, &tj);
+  if (height) *height = 0.0;
+  if (code == 0) return 0;
+  const int level = code - 1;
+  if (height) {
+    const cv::Vec2d slope = terraceSlope(ti, tj, level);
+    *height = config_.levels[level].height + slope[0] * (x - (ti + 0.5) * terrace_side_) +
+              slope[1] * (y - (tj + 0.5) * terrace_side_);
+  }
+  return code;
+}
+
+SceneHit Scene::cast(const cv::Vec3d& o, const cv::Vec3d& d) const {
+  SceneHit best;
+  best.t = o[2] / -d[2];
+  best.x = o[0] + best.t * d[0];
+  best.y = o[1] + best.t * d[1];
+  const double horizontal = std::sqrt(d[0] * d[0] + d[1] * d[1]) / -d[2];
+  for (int l = 0; l < static_cast<int>(config_.levels.size()); ++l) {
+    const double h = config_.levels[l].height;
+    const double t0 = (o[2] - h) / -d[2];
+    if (t0 <= 0.0) continue;
+    const double x0 = o[0] + t0 * d[0], y0 = o[1] + t0 * d[1];
+    if (level_reach_[l] == 0.0) {  // flat: the crossing of z = h is the only candidate
+      long long ti = 0, tj = 0;
+      if (t0 < best.t && topAt(x0, y0, &ti, &tj) == l + 1) {
+        best.layer = l + 1;
+        best.t = t0;
+        best.x = x0;
+        best.y = y0;
+      }
+      continue;
+    }
+    // Any top of this level lies within level_reach_ of height h, so the ray meets it within
+    // `reach` (horizontally) of where it crosses z = h: only terraces that near can be hit.
+    const double reach = level_reach_[l] * horizontal;
+    const long long ti_end = floorIndex((x0 + reach) / terrace_side_);
+    const long long tj_end = floorIndex((y0 + reach) / terrace_side_);
+    for (long long ti = floorIndex((x0 - reach) / terrace_side_); ti <= ti_end; ++ti) {
+      for (long long tj = floorIndex((y0 - reach) / terrace_side_); tj <= tj_end; ++tj) {
+        if (terraceLevel(ti, tj) != l) continue;
+        const cv::Vec2d slope = terraceSlope(ti, tj, l);
+        const double centre_x = (ti + 0.5) * terrace_side_, centre_y = (tj + 0.5) * terrace_side_;
+        // o.z + t d.z = h + sx (o.x + t d.x - cx) + sy (o.y + t d.y - cy)
+        const double denominator = d[2] - slope[0] * d[0] - slope[1] * d[1];
+        if (denominator >= 0.0) continue;
+        const double t = (h + slope[0] * (o[0] - centre_x) + slope[1] * (o[1] - centre_y) - o[2]) / denominator;
+        if (t <= 0.0 || t >= best.t) continue;
+        const double x = o[0] + t * d[0], y = o[1] + t * d[1];
+        long long hit_ti = 0, hit_tj = 0;
+        if (topAt(x, y, &hit_ti, &hit_tj) != l + 1 || hit_ti != ti || hit_tj != tj) continue;
+        best.layer = l + 1;
+        best.t = t;
+        best.x = x;
+        best.y = y;
+      }
+    }
+  }
+  best.z = o[2] + best.t * d[2];
+  return best;
+}
+
+float Scene::sample(int layer, double x, double y) const {
+  const cv::Mat1f& texture = textures_[layer];
+  const double w = texture.cols, h = texture.rows;
+  // Texture rows run southwards so that a texture looks upright in a yaw-0 image.
+  double u = x / config_.texel, v = -y / config_.texel;
+  u -= std::floor(u / w) * w;
+  v -= std::floor(v / h) * h;
+  int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+  const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
+  if (u0 >= texture.cols) u0 -= texture.cols;  // rounding at the wrap
+  if (v0 >= texture.rows) v0 -= texture.rows;
+  const int u1 = u0 + 1 == texture.cols ? 0 : u0 + 1;
+  const int v1 = v0 + 1 == texture.rows ? 0 : v0 + 1;
+  const float* r0 = texture[v0];
+  const float* r1 = texture[v1];
+  const float top = r0[u0] + fu * (r0[u1] - r0[u0]);
+  const float bottom = r1[u0] + fu * (r1[u1] - r1[u0]);
+  return top + fv * (bottom - top);
+}
+
+}  // namespace sim
+}  // namespace oefmt

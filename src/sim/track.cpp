@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/sim/track.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "oefmt/error.h"
+
+namespace oefmt {
+namespace sim {
+namespace {
+
+// The track's shape at unit size, u in [0, 1].
+cv::Point2d unitShape(const TrackConfig& config, double u) {
+  const double a = 2.0 * CV_PI * u;
+  switch (config.shape) {
+    case TrackShape::kCircle: return {std::cos(a), std::sin(a)};
+    case TrackShape::kEight: return {std::sin(a), std::sin(a) * std::cos(a)};
+    case TrackShape::kLine: break;
+  }
+  return {u * std::cos(config.line_direction), u * std::sin(config.line_direction)};
+}
+
+// Speed |d shape / du| of the unit shape.
+double unitSpeed(const TrackConfig& config, double u) {
+  const double a = 2.0 * CV_PI * u;
+  switch (config.shape) {
+    case TrackShape::kCircle: return 2.0 * CV_PI;
+    case TrackShape::kEight: return 2.0 * CV_PI * std::hypot(std::cos(a), std::cos(2.0 * a));
+    case TrackShape::kLine: break;
+  }
+  return 1.0;
+}
+
+// Arc length of the unit shape at u = k / (samples - 1) (Simpson's rule on the speed: exact for
+// the circle and the line), to walk it at constant speed.
+struct ArcTable {
+  std::vector<double> u;
+  std::vector<double> length;
+
+  explicit ArcTable(const TrackConfig& config, int samples = 20001) {
+    u.resize(samples);
+    length.resize(samples, 0.0);
+    for (int k = 0; k < samples; ++k) {
+      u[k] = static_cast<double>(k) / (samples - 1);
+      if (k == 0) continue;
+      const double h = u[k] - u[k - 1];
+      length[k] = length[k - 1] + h / 6.0 *
+                                      (unitSpeed(config, u[k - 1]) + 4.0 * unitSpeed(config, u[k - 1] + h / 2.0) +
+                                       unitSpeed(config, u[k]));
+    }
+  }
+  double total() const { return length.back(); }
+  // u at arc length s (linear between samples).
+  double at(double s) const {
+    const auto it = std::lower_bound(length.begin(), length.end(), s);
+    if (it == length.begin()) return 0.0;
+    if (it == length.end()) return 1.0;
+    const std::size_t k = static_cast<std::size_t>(it - length.begin());
+    const double span = length[k] - length[k - 1];
+    const double f = span > 0.0 ? (s - length[k - 1]) / span : 0.0;
+    return u[k - 1] + f * (u[k] - u[k - 1]);
+  }
+};
+
+}  // namespace
+
+void TrackConfig::validate() const {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError("track: " + what);
+  };
+  require(length > 0.0 && std::isfinite(length), "length must be > 0");
+  require(frames >= 2, "frames must be >= 2");
+  require(altitude > 0.0 && std::isfinite(altitude), "altitude must be > 0");
+  require(std::isfinite(climb) && altitude + climb > 0.0, "altitude + climb must stay > 0");
+  require(std::isfinite(yaw) && std::isfinite(line_direction), "angles must be finite");
+}
+
+bool isClosed(TrackShape shape) { return shape != TrackShape::kLine; }
+
+double frameSpacing(const TrackConfig& config) { return config.length / (config.frames - 1); }
+
+std::vector<FlightPose> makeTrack(const TrackConfig& config) {
+  config.validate();
+  const ArcTable table(config);
+  const double scale = config.length / table.total();
+  const double step = frameSpacing(config);
+  std::vector<FlightPose> poses;
+  for (int k = 0; k < config.frames; ++k) {
+    const double s = k == config.frames - 1 ? config.length : k * step;  // exact closure
+    const double fraction = s / config.length;
+    const double u = table.at(s / scale);
+    FlightPose pose;
+    const cv::Point2d p = unitShape(config, u) * scale;
+    const double profile = isClosed(config.shape) ? 0.5 * (1.0 - std::cos(2.0 * CV_PI * fraction)) : fraction;
+    pose.position = cv::Vec3d(p.x, p.y, config.altitude + config.climb * profile);
+    pose.yaw = config.yaw;
+    if (config.heading == HeadingMode::kTrack) {
+      // Direction of motion from a short chord around u (the shapes are smooth).
+      const double du = 1e-5;
+      const cv::Point2d ahead = unitShape(config, std::min(1.0, u + du));
+      const cv::Point2d behind = unitShape(config, std::max(0.0, u - du));
+      pose.yaw += std::atan2(ahead.y - behind.y, ahead.x - behind.x);
+      pose.yaw = std::remainder(pose.yaw, 2.0 * CV_PI);
+    }
+    poses.push_back(pose);
+  }
+  if (isClosed(config.shape)) {
+    poses.back() = poses.front();  // bit-identical loop closure
+  }
+  return poses;
+}
+
+TrackShape trackShapeFromString(const std::string& name) {
+  if (name == "circle") return TrackShape::kCircle;
+  if (name == "eight") return TrackShape::kEight;
+  if (name == "line") return TrackShape::kLine;
+  throw InputError("unknown track '" + name + "' (expected circle, eight or line)");
+}
+
+const char* toString(TrackShape shape) {
+  switch (shape) {
+    case TrackShape::kCircle: return "circle";
+    case TrackShape::kEight: return "eight";
+    case TrackShape::kLine: return "line";
+  }
+  return "?";
+}
+
+}  // namespace sim
+}  // namespace oefmt

@@ -1,0 +1,317 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// oefmt_simulate: renders a flight of a down-looking camera over a multi-depth textured scene and
+// writes it in the authors' dataset layout with ground truth (and optionally as a ROS bag).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "oefmt/error.h"
+#include "oefmt/ros/bag_io.h"
+#include "oefmt/sim/flight.h"
+#include "oefmt/sim/folder_writer.h"
+#include "oefmt/sim/progress.h"
+
+namespace {
+
+const char* const kUsage = R"(usage: oefmt_simulate [options] OUTPUT_DIR
+
+Renders a flight of a pinhole camera looking straight down at a textured ground plane with raised
+block tops at further heights (the last level's terraces inclined), and writes OUTPUT_DIR in the
+o-eFMT authors' layout: Images/0001.png..., imageList.txt, timestamps.txt (seconds),
+cam_param.yaml, plus groundtruth.tum (t x y z qx qy qz qw; world x east, y north, z up).
+Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames, 512x512).
+
+track:
+  --track circle|eight|line  shape (default circle)
+  --length M                 path length [m] (default circle 491, eight 880, line 200)
+  --frames N                 frames (default circle 200, eight 300, line 100); loops repeat the
+                             first frame at the end
+  --altitude M               height above the ground [m] (default: from --overlap)
+  --overlap F                target mean overlap of consecutive frames on the ground (0.78)
+  --climb M                  altitude change [m]: a line climbs linearly, a loop climbs to it
+                             half-way and back (default 0)
+  --heading fixed|track      yaw fixed, or following the direction of motion (default fixed)
+  --yaw DEG                  fixed yaw, or offset to the direction of motion (default 0)
+  --direction DEG            direction of a line track, from east counter-clockwise (default 0)
+camera:
+  --size PX                  width and height (default 512)
+  --width PX, --height PX
+  --fx PX, --fy PX           focal lengths (default: 60 deg horizontal field of view; fy = fx)
+  --cx PX, --cy PX           principal point (default: image centre)
+  --k1 K, --k2 K             radial distortion rendered and written to cam_param/CameraInfo
+scene:
+  --seed N                   scene and noise seed (default 1)
+  --levels H1,H2,...         raised levels' heights [m] (default 0.15 and 0.30 of the altitude)
+  --incline DEG              tilt of the last level's terraces (default 6)
+  --cell M                   block pitch [m] (default 0.22 of the ground footprint width)
+  --texel M                  texture resolution [m] (default half a ground pixel)
+  --texture-size N           procedural texture side [texels] (default 8 x width, <= 4096)
+  --texture LAYER=FILE       image file as texture of a layer (0 ground, 1.. levels); repeatable
+rendering and sensor:
+  --supersample N            N x N rays per pixel (default 2)
+  --noise SIGMA              Gaussian noise std, intensity 0..1 (default 0)
+  --brightness A             frame gain 1 + A sin(2 pi k / period) (default 0)
+  --brightness-period N      frames (default 50)
+  --threads N                rendering threads (default: all cores)
+time and output:
+  --rate HZ                  frame rate (default 5)
+  --start-time S             stamp of the first frame (default 1.0)
+  --bag FILE                 also write a ROS bag (sensor_msgs/Image + CameraInfo)
+  --bag-compression C        none, lz4 or bz2 (default none)
+  --image-topic T            (default /camera/image_raw)
+  --info-topic T             (default /camera/camera_info)
+  --frame-id F               (default camera_optical)
+  --quiet                    print nothing but errors
+  -h, --help
+exit codes: 0 success, 1 write failure, 2 invalid option)";
+
+class Arguments {
+ public:
+  Arguments(int argc, char** argv) : args_(argv + 1, argv + argc) {}
+  bool done() const { return index_ >= args_.size(); }
+  std::string take() { return args_[index_++]; }
+  std::string value(const std::string& option) {
+    if (done()) throw oefmt::InputError("option " + option + " needs a value");
+    return take();
+  }
+  double number(const std::string& option) {
+    const std::string text = value(option);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) {
+      throw oefmt::InputError("option " + option + " needs a number, got '" + text + "'");
+    }
+    return v;
+  }
+  int integer(const std::string& option) {
+    const double v = number(option);
+    if (v != std::floor(v) || std::fabs(v) > 1e9) throw oefmt::InputError("option " + option + " needs an integer");
+    return static_cast<int>(v);
+  }
+
+ private:
+  std::vector<std::string> args_;
+  std::size_t index_ = 0;
+};
+
+std::vector<double> numberList(const std::string& option, const std::string& text) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v)) {
+      throw oefmt::InputError("option " + option + " needs numbers separated by commas, got '" + text + "'");
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+constexpr double kDeg = CV_PI / 180.0;
+
+struct Command {
+  oefmt::sim::FlightOptions flight;
+  std::string output;
+  std::string bag;
+  oefmt::BagWriterOptions bag_options;
+  int threads = -1;
+  bool quiet = false;
+  bool help = false;
+};
+
+Command parse(int argc, char** argv) {
+  Command command;
+  oefmt::sim::FlightOptions& f = command.flight;
+  bool length_set = false, frames_set = false;
+  Arguments args(argc, argv);
+  while (!args.done()) {
+    const std::string arg = args.take();
+    if (arg == "-h" || arg == "--help") {
+      command.help = true;
+      return command;
+    } else if (arg == "--track") {
+      f.track.shape = oefmt::sim::trackShapeFromString(args.value(arg));
+    } else if (arg == "--length") {
+      f.track.length = args.number(arg);
+      length_set = true;
+    } else if (arg == "--frames") {
+      f.track.frames = args.integer(arg);
+      frames_set = true;
+    } else if (arg == "--altitude") {
+      f.track.altitude = args.number(arg);
+      if (!(f.track.altitude > 0.0)) throw oefmt::InputError("--altitude must be > 0");
+    } else if (arg == "--overlap") {
+      f.overlap = args.number(arg);
+    } else if (arg == "--climb") {
+      f.track.climb = args.number(arg);
+    } else if (arg == "--heading") {
+      const std::string mode = args.value(arg);
+      if (mode != "fixed" && mode != "track") throw oefmt::InputError("--heading must be fixed or track");
+      f.track.heading = mode == "fixed" ? oefmt::sim::HeadingMode::kFixed : oefmt::sim::HeadingMode::kTrack;
+    } else if (arg == "--yaw") {
+      f.track.yaw = args.number(arg) * kDeg;
+    } else if (arg == "--direction") {
+      f.track.line_direction = args.number(arg) * kDeg;
+    } else if (arg == "--size") {
+      f.width = f.height = args.integer(arg);
+    } else if (arg == "--width") {
+      f.width = args.integer(arg);
+    } else if (arg == "--height") {
+      f.height = args.integer(arg);
+    } else if (arg == "--fx") {
+      f.fx = args.number(arg);
+    } else if (arg == "--fy") {
+      f.fy = args.number(arg);
+    } else if (arg == "--cx") {
+      f.cx = args.number(arg);
+    } else if (arg == "--cy") {
+      f.cy = args.number(arg);
+    } else if (arg == "--k1") {
+      f.distortion.k1 = args.number(arg);
+    } else if (arg == "--k2") {
+      f.distortion.k2 = args.number(arg);
+    } else if (arg == "--seed") {
+      const int seed = args.integer(arg);
+      if (seed < 0) throw oefmt::InputError("--seed must be >= 0");
+      f.seed = static_cast<std::uint32_t>(seed);
+    } else if (arg == "--levels") {
+      f.level_heights = numberList(arg, args.value(arg));
+    } else if (arg == "--incline") {
+      f.incline_deg = args.number(arg);
+    } else if (arg == "--cell") {
+      f.cell_size = args.number(arg);
+    } else if (arg == "--texel") {
+      f.texel = args.number(arg);
+    } else if (arg == "--texture-size") {
+      f.texture_size = args.integer(arg);
+    } else if (arg == "--texture") {
+      const std::string spec = args.value(arg);
+      const auto equals = spec.find('=');
+      char* end = nullptr;
+      const long layer = equals == std::string::npos ? -1 : std::strtol(spec.c_str(), &end, 10);
+      if (layer < 0 || layer > 16 || end != spec.c_str() + equals || equals + 1 >= spec.size()) {
+        throw oefmt::InputError("--texture needs LAYER=FILE with LAYER 0 (ground), 1, 2, ...");
+      }
+      if (f.texture_files.size() <= static_cast<std::size_t>(layer)) f.texture_files.resize(layer + 1);
+      f.texture_files[layer] = spec.substr(equals + 1);
+    } else if (arg == "--supersample") {
+      f.supersample = args.integer(arg);
+    } else if (arg == "--noise") {
+      f.sensor.noise = args.number(arg);
+    } else if (arg == "--brightness") {
+      f.sensor.brightness = args.number(arg);
+    } else if (arg == "--brightness-period") {
+      f.sensor.brightness_period = args.number(arg);
+    } else if (arg == "--threads") {
+      command.threads = args.integer(arg);
+      if (command.threads < 1) throw oefmt::InputError("--threads must be >= 1");
+    } else if (arg == "--rate") {
+      f.rate = args.number(arg);
+    } else if (arg == "--start-time") {
+      f.start_time = args.number(arg);
+    } else if (arg == "--bag") {
+      command.bag = args.value(arg);
+    } else if (arg == "--bag-compression") {
+      command.bag_options.compression = args.value(arg);
+    } else if (arg == "--image-topic") {
+      command.bag_options.image_topic = args.value(arg);
+    } else if (arg == "--info-topic") {
+      command.bag_options.camera_info_topic = args.value(arg);
+    } else if (arg == "--frame-id") {
+      command.bag_options.frame_id = args.value(arg);
+    } else if (arg == "--quiet") {
+      command.quiet = true;
+    } else if (!arg.empty() && arg[0] == '-') {
+      throw oefmt::InputError("unknown option '" + arg + "' (see --help)");
+    } else if (command.output.empty()) {
+      command.output = arg;
+    } else {
+      throw oefmt::InputError("more than one output folder given ('" + command.output + "', '" + arg + "')");
+    }
+  }
+  if (command.output.empty()) throw oefmt::InputError("no OUTPUT_DIR given (see --help)");
+  using oefmt::sim::TrackShape;
+  if (!length_set) f.track.length = f.track.shape == TrackShape::kEight ? 880.0 : f.track.shape == TrackShape::kLine ? 200.0 : 491.0;
+  if (!frames_set) f.track.frames = f.track.shape == TrackShape::kEight ? 300 : f.track.shape == TrackShape::kLine ? 100 : 200;
+  return command;
+}
+
+void printPlan(const oefmt::sim::FlightPlan& plan, const Command& command) {
+  const oefmt::Intrinsics& k = plan.camera.intrinsics;
+  const auto& t = plan.track;
+  std::printf("track       %s, %zu frames, %.1f m (%.3f m per frame), heading %s, yaw %.1f deg\n",
+              oefmt::sim::toString(t.shape), plan.poses.size(), t.length, oefmt::sim::frameSpacing(t),
+              t.heading == oefmt::sim::HeadingMode::kFixed ? "fixed" : "along track", t.yaw / kDeg);
+  std::printf("altitude    %.3f m%s, climb %.2f m\n", t.altitude,
+              command.flight.track.altitude > 0.0 ? "" : " (from the target overlap)", t.climb);
+  std::printf("camera      %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f, k1 %.4g k2 %.4g, ground pixel %.4f m\n",
+              k.width, k.height, k.fx, k.fy, k.cx, k.cy, plan.camera.distortion.k1, plan.camera.distortion.k2,
+              t.altitude / k.fx);
+  std::printf("scene       seed %u, ground + %zu levels:", plan.scene.seed, plan.scene.levels.size());
+  for (const auto& level : plan.scene.levels) std::printf(" %.2f m (incline %.1f deg)", level.height, level.incline_deg);
+  std::printf("\n            cell %.3f m, texel %.4f m, textures %d px, supersample %dx%d\n", plan.scene.cell_size,
+              plan.scene.texel, plan.scene.texture_size, plan.supersample, plan.supersample);
+  std::printf("overlap     consecutive frames on the ground: min %.1f %%, mean %.1f %%, max %.1f %%\n",
+              plan.ground_overlap.min * 100, plan.ground_overlap.mean * 100, plan.ground_overlap.max * 100);
+  std::printf("            on the highest level:             min %.1f %%, mean %.1f %%, max %.1f %%\n",
+              plan.top_overlap.min * 100, plan.top_overlap.mean * 100, plan.top_overlap.max * 100);
+  std::printf("time        %.3f .. %.3f s at %.3g Hz\n", plan.stamps.front(), plan.stamps.back(), command.flight.rate);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Command command;
+  try {
+    command = parse(argc, argv);
+  } catch (const oefmt::InputError& e) {
+    std::fprintf(stderr, "oefmt_simulate: %s\n", e.what());
+    return 2;
+  }
+  if (command.help) {
+    std::puts(kUsage);
+    return 0;
+  }
+  if (command.threads > 0) cv::setNumThreads(command.threads);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const oefmt::sim::FlightPlan plan = oefmt::sim::planFlight(command.flight);
+    if (!command.quiet) printPlan(plan, command);
+    oefmt::sim::FolderFlightWriter folder(command.output, plan.camera, static_cast<int>(plan.poses.size()),
+                                          oefmt::sim::groundTruthHeader(plan));
+    std::unique_ptr<oefmt::BagFlightWriter> bag;
+    if (!command.bag.empty()) bag = std::make_unique<oefmt::BagFlightWriter>(command.bag, plan.camera, command.bag_options);
+    oefmt::sim::ProgressBar progress("rendering", plan.poses.size(), command.quiet ? nullptr : stderr);
+    oefmt::sim::renderFlight(plan, [&](int k, const cv::Mat1b& image, const cv::Mat1b&) {
+      folder.write(image, plan.poses[k], plan.stamps[k]);
+      if (bag) bag->write(image, plan.stamps[k]);
+      progress.update(static_cast<std::size_t>(k) + 1);
+    });
+    progress.finish();
+    folder.finish();
+    if (bag) bag->close();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!command.quiet) {
+      std::printf("wrote       %s (%zu frames)%s%s in %.1f s (%.1f ms per frame)\n", command.output.c_str(),
+                  plan.poses.size(), bag ? " and " : "", bag ? command.bag.c_str() : "", seconds,
+                  seconds * 1000.0 / plan.poses.size());
+    }
+    return 0;
+  } catch (const oefmt::InputError& e) {
+    std::fprintf(stderr, "oefmt_simulate: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {  // DatasetError, BagError, cv::Exception
+    std::fprintf(stderr, "oefmt_simulate: %s\n", e.what());
+    return 1;
+  }
+}

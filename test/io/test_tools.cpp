@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The command-line tools end to end: simulate -> folder + bag, folder -> bag, evaluate; their
+// exit codes and messages for bad input.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "io/temp_dir.h"
+#include "oefmt/dataset.h"
+#include "oefmt/ros/bag_io.h"
+
+namespace oefmt {
+namespace {
+
+using test::TempDir;
+
+struct ToolRun {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Runs `command` (a tool path and arguments, no shell characters) and collects its output.
+ToolRun run(const TempDir& dir, const std::string& command) {
+  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const int raw = std::system((command + " >" + out + " 2>" + err + " </dev/null").c_str());
+  ToolRun result;
+  result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  result.out = readFile(out);
+  result.err = readFile(err);
+  return result;
+}
+
+TEST(Tools, SimulateConvertAndEvaluate) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --size 96 --frames 6 --length 15 --seed 3 --bag " +
+                                    (dir / "sim.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  EXPECT_NE(simulate.out.find("overlap"), std::string::npos);
+  EXPECT_EQ(simulate.err.find('\r'), std::string::npos);  // no progress bar when not a terminal
+
+  const FolderDataset dataset(dir / "flight");
+  EXPECT_EQ(dataset.size(), 6u);
+  EXPECT_EQ(BagImageReader(dir / "sim.bag").size(), 6u);
+
+  const ToolRun convert = run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " --quiet " + (dir / "flight") + " " + (dir / "conv.bag"));
+  ASSERT_EQ(convert.status, 0) << convert.err;
+  BagImageReader reader(dir / "conv.bag");
+  BagFrame frame;
+  ASSERT_TRUE(reader.next(frame));
+  EXPECT_EQ(cv::norm(frame.image, dataset.loadImage(0), cv::NORM_INF), 0.0);
+
+  const std::string truth = dir / "flight/groundtruth.tum";
+  const ToolRun evaluate = run(dir, std::string(OEFMT_EVALUATE) + " --json-only " + truth + " " + truth);
+  ASSERT_EQ(evaluate.status, 0) << evaluate.err;
+  EXPECT_EQ(evaluate.out.rfind("{\"estimate_poses\":6,", 0), 0u) << evaluate.out;
+  EXPECT_NE(evaluate.out.find("\"rmse\":0"), std::string::npos) << evaluate.out;
+}
+
+TEST(Tools, ExitCodesAndMessages) {
+  TempDir dir;
+  EXPECT_EQ(run(dir, std::string(OEFMT_SIMULATE) + " --help").status, 0);
+  EXPECT_EQ(run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " --help").status, 0);
+  EXPECT_EQ(run(dir, std::string(OEFMT_EVALUATE) + " --help").status, 0);
+
+  ToolRun bad = run(dir, std::string(OEFMT_SIMULATE) + " --track square " + (dir / "x"));
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("unknown track 'square'"), std::string::npos) << bad.err;
+  bad = run(dir, std::string(OEFMT_SIMULATE) + " --frames");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("needs a value"), std::string::npos) << bad.err;
+
+  bad = run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " " + (dir / "missing") + " " + (dir / "out.bag"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("missing"), std::string::npos) << bad.err;
+
+  std::ofstream(dir / "a.tum") << "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n";
+  std::ofstream(dir / "b.tum") << "5 0 0 0 0 0 0 1\n6 1 0 0 0 0 0 1\n";
+  bad = run(dir, std::string(OEFMT_EVALUATE) + " " + (dir / "a.tum") + " " + (dir / "b.tum"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("--match index"), std::string::npos) << bad.err;
+  const ToolRun by_index = run(dir, std::string(OEFMT_EVALUATE) + " --match index " + (dir / "a.tum") + " " + (dir / "b.tum"));
+  EXPECT_EQ(by_index.status, 0) << by_index.err;
+  EXPECT_EQ(run(dir, std::string(OEFMT_EVALUATE) + " --tolerance x a b").status, 2);
+}
+
+}  // namespace
+}  // namespace oefmt
