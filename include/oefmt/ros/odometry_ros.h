@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The ROS face of the estimator: parameters, subscriptions, a worker thread, publishers.
+// Shared by the nodelet (oefmt/OdometryNodelet) and the standalone node (oefmt_node); it adds
+// nothing numeric of its own.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <image_transport/image_transport.h>
+#include <nav_msgs/Path.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/Range.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "oefmt/estimator.h"
+#include "oefmt/estimator_config.h"
+#include "oefmt/ros/latest_slot.h"
+#include "oefmt/stamp_guard.h"
+
+namespace oefmt {
+
+/// Parameters that only the ROS wrapper has (the estimator's come from the same YAML file as
+/// oefmt_offline's, see config/default.yaml).
+struct RosParameters {
+  std::string odom_frame = "odom";
+  std::string base_frame = "base_link";
+  std::string camera_frame;          ///< empty: the image header's frame_id
+  bool publish_tf = true;
+  bool compressed = false;           ///< subscribe to image/compressed instead of image
+  int queue_size = 2;                ///< subscriber queue of image, camera_info
+  int path_length = 2000;            ///< poses kept in the published path (0 = no path)
+  double fx = 0.0;                   ///< focal length [px] of the camera image when no camera_info
+  double fy = 0.0;                   ///< (unused by 4-DOF odometry; kept for symmetry and checks)
+  double initial_altitude = 0.0;     ///< altitude above the dominant plane at start [m], 0 = unknown
+  bool use_altitude_topic = false;   ///< take the initial altitude from the `altitude` Range topic
+  double time_jump_tolerance = 1.0;  ///< a stamp this far back [s] resets (bag loop)
+  double diagnostics_period = 1.0;   ///< [s]
+  double min_rate = 1.0;             ///< expected input/output rate window [Hz] for diagnostics
+  double max_rate = 100.0;
+};
+
+class OdometryRos {
+ public:
+  /// Reads and validates the parameters (a bad value is fatal, naming the parameter),
+  /// subscribes and starts the worker thread.
+  OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const std::string& name);
+  ~OdometryRos();
+  OdometryRos(const OdometryRos&) = delete;
+  OdometryRos& operator=(const OdometryRos&) = delete;
+
+ private:
+  /// A frame as received: decoding happens on the worker, callbacks only store pointers.
+  struct InputFrame {
+    sensor_msgs::ImageConstPtr image;
+    sensor_msgs::CompressedImageConstPtr compressed;
+    ros::Time stamp;
+    std::string frame_id;
+    ros::WallTime received;
+  };
+
+  void loadParameters();
+  EstimatorConfig loadEstimatorConfig();
+  void imageCallback(const sensor_msgs::ImageConstPtr& message);
+  void compressedCallback(const sensor_msgs::CompressedImageConstPtr& message);
+  void cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& message);
+  void altitudeCallback(const sensor_msgs::RangeConstPtr& message);
+  bool resetService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  void enqueue(InputFrame frame);
+  void workerLoop();
+  void process(const InputFrame& frame);
+  bool prepareEstimator(const InputFrame& frame, const cv::Mat& image);
+  cv::Mat decode(const InputFrame& frame);
+  void undistortIfNeeded(cv::Mat& image);
+  void publish(const InputFrame& frame, const Estimate& estimate);
+  void publishDebugImages(const InputFrame& frame, const Estimate& estimate);
+  void resetEstimator(const std::string& why);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+
+  ros::NodeHandle nh_, private_nh_;
+  std::string name_;
+  RosParameters parameters_;
+  EstimatorConfig estimator_config_;
+
+  image_transport::ImageTransport image_transport_;
+  image_transport::Subscriber image_subscriber_;
+  ros::Subscriber compressed_subscriber_, camera_info_subscriber_, altitude_subscriber_;
+  ros::Publisher odometry_publisher_, path_publisher_, energy_publisher_;
+  image_transport::Publisher energy_image_publisher_, rotation_zoom_publisher_,
+      translation_publisher_;
+  ros::ServiceServer reset_server_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+
+  // Camera model: guarded by camera_mutex_ (written by callbacks, read by the worker).
+  std::mutex camera_mutex_;
+  sensor_msgs::CameraInfoConstPtr camera_info_;
+  std::optional<double> altitude_from_topic_;
+
+  // Worker state (worker thread only).
+  LatestSlot<InputFrame> slot_;
+  std::thread worker_;
+  std::unique_ptr<Estimator> estimator_;
+  StampGuard stamp_guard_;
+  nav_msgs::Path path_;
+  std::optional<Pose4> previous_pose_;
+  cv::Size input_size_;
+  double estimator_fx_ = 0.0;
+  cv::Mat undistort_map1_, undistort_map2_;
+  std::string undistort_key_;
+  std::atomic<bool> reset_requested_{false};
+
+  // Counters for diagnostics (atomics: written by callbacks and worker, read by the updater).
+  diagnostic_updater::Updater updater_;
+  std::atomic<long> frames_in_{0}, frames_out_{0}, frames_dropped_{0}, frames_rejected_{0},
+      optimizer_failures_{0}, registration_failures_{0};
+  std::atomic<double> last_processing_ms_{0.0}, last_confidence_{1.0}, last_latency_ms_{0.0};
+  std::mutex diagnostics_mutex_;
+  std::string last_problem_;
+  double min_rate_, max_rate_;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> input_rate_, output_rate_;
+  ros::Timer diagnostics_timer_;
+};
+
+}  // namespace oefmt

@@ -1,0 +1,433 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/ros/odometry_ros.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include <cv_bridge/cv_bridge.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/Odometry.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <ros/package.h>
+#include <tf2/LinearMath/Matrix3x3.h>
+#include <tf2/LinearMath/Quaternion.h>
+
+#include "oefmt/EnergyVectors.h"
+#include "oefmt/error.h"
+#include "oefmt/ros/bag_io.h"
+#include "oefmt/ros/estimate_messages.h"
+#include "oefmt/ros/parameter_yaml.h"
+#include "oefmt/trajectory.h"
+
+namespace oefmt {
+namespace {
+
+constexpr double kWarnPeriod = 5.0;  // [s] between repeats of a per-frame warning
+
+template <typename T>
+T param(const ros::NodeHandle& nh, const std::string& key, const T& fallback) {
+  T value;
+  nh.param<T>(key, value, fallback);
+  return value;
+}
+
+[[noreturn]] void fatalParameter(const std::string& name, const std::string& key,
+                                 const std::string& rule) {
+  const std::string message = name + ": invalid parameter ~" + key + ": " + rule;
+  ROS_FATAL_STREAM(message);
+  throw InputError(message);
+}
+
+bool validFrameName(const std::string& frame) {
+  return !frame.empty() && frame[0] != '/' && frame.find(' ') == std::string::npos;
+}
+
+}  // namespace
+
+OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const std::string& name)
+    : nh_(nh),
+      private_nh_(private_nh),
+      name_(name),
+      image_transport_(nh),
+      tf_listener_(tf_buffer_) {
+  loadParameters();
+  estimator_config_ = loadEstimatorConfig();
+  stamp_guard_ = StampGuard(parameters_.time_jump_tolerance);
+  ROS_INFO_STREAM(name_ << ": effective estimator configuration:\n" << configToYaml(estimator_config_));
+
+  odometry_publisher_ = nh_.advertise<nav_msgs::Odometry>("odom", 20);
+  if (parameters_.path_length > 0) path_publisher_ = nh_.advertise<nav_msgs::Path>("path", 2);
+  energy_publisher_ = nh_.advertise<oefmt::EnergyVectors>("energy_vectors", 10);
+  energy_image_publisher_ = image_transport_.advertise("debug/energy_vectors", 1);
+  rotation_zoom_publisher_ = image_transport_.advertise("debug/rotation_zoom_psd", 1);
+  translation_publisher_ = image_transport_.advertise("debug/translation_psd", 1);
+  reset_server_ = private_nh_.advertiseService("reset", &OdometryRos::resetService, this);
+
+  updater_.setHardwareID(name_);
+  min_rate_ = parameters_.min_rate;
+  max_rate_ = parameters_.max_rate;
+  input_rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+      diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10), "input rate");
+  output_rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+      diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10), "odometry rate");
+  updater_.add(*input_rate_);
+  updater_.add(*output_rate_);
+  updater_.add("odometry", this, &OdometryRos::diagnose);
+  diagnostics_timer_ = nh_.createTimer(ros::Duration(parameters_.diagnostics_period),
+                                       [this](const ros::TimerEvent&) { updater_.update(); });
+
+  camera_info_subscriber_ =
+      nh_.subscribe("camera_info", parameters_.queue_size, &OdometryRos::cameraInfoCallback, this);
+  if (parameters_.use_altitude_topic) {
+    altitude_subscriber_ = nh_.subscribe("altitude", 5, &OdometryRos::altitudeCallback, this);
+  }
+  worker_ = std::thread(&OdometryRos::workerLoop, this);
+  if (parameters_.compressed) {
+    // Debian packages no compressed image_transport plugin: decode CompressedImage ourselves.
+    compressed_subscriber_ = nh_.subscribe(nh_.resolveName("image") + "/compressed",
+                                           parameters_.queue_size,
+                                           &OdometryRos::compressedCallback, this);
+  } else {
+    image_subscriber_ = image_transport_.subscribe(
+        "image", parameters_.queue_size, &OdometryRos::imageCallback, this,
+        image_transport::TransportHints("raw", ros::TransportHints(), private_nh_));
+  }
+  ROS_INFO_STREAM(name_ << ": listening on " << nh_.resolveName("image")
+                        << (parameters_.compressed ? "/compressed" : "") << ", publishing "
+                        << nh_.resolveName("odom") << " (" << parameters_.odom_frame << " -> "
+                        << parameters_.base_frame << ")");
+}
+
+OdometryRos::~OdometryRos() {
+  slot_.shutdown();
+  if (worker_.joinable()) worker_.join();
+}
+
+void OdometryRos::loadParameters() {
+  RosParameters& p = parameters_;
+  p.odom_frame = param(private_nh_, "odom_frame", p.odom_frame);
+  p.base_frame = param(private_nh_, "base_frame", p.base_frame);
+  p.camera_frame = param(private_nh_, "camera_frame", p.camera_frame);
+  p.publish_tf = param(private_nh_, "publish_tf", p.publish_tf);
+  p.compressed = param(private_nh_, "compressed", p.compressed);
+  p.queue_size = param(private_nh_, "queue_size", p.queue_size);
+  p.path_length = param(private_nh_, "path_length", p.path_length);
+  p.fx = param(private_nh_, "fx", p.fx);
+  p.fy = param(private_nh_, "fy", p.fy);
+  p.initial_altitude = param(private_nh_, "initial_altitude", p.initial_altitude);
+  p.use_altitude_topic = param(private_nh_, "use_altitude_topic", p.use_altitude_topic);
+  p.time_jump_tolerance = param(private_nh_, "time_jump_tolerance", p.time_jump_tolerance);
+  p.diagnostics_period = param(private_nh_, "diagnostics_period", p.diagnostics_period);
+  p.min_rate = param(private_nh_, "min_rate", p.min_rate);
+  p.max_rate = param(private_nh_, "max_rate", p.max_rate);
+
+  if (!validFrameName(p.odom_frame)) fatalParameter(name_, "odom_frame", "must be a non-empty frame name without a leading '/'");
+  if (!validFrameName(p.base_frame)) fatalParameter(name_, "base_frame", "must be a non-empty frame name without a leading '/'");
+  if (p.odom_frame == p.base_frame) fatalParameter(name_, "base_frame", "must differ from ~odom_frame");
+  if (!p.camera_frame.empty() && !validFrameName(p.camera_frame)) fatalParameter(name_, "camera_frame", "must not start with '/'");
+  if (p.queue_size < 1 || p.queue_size > 100) fatalParameter(name_, "queue_size", "must be in [1, 100]");
+  if (p.path_length < 0) fatalParameter(name_, "path_length", "must be >= 0");
+  if (!(p.fx >= 0.0) || !std::isfinite(p.fx)) fatalParameter(name_, "fx", "must be >= 0 (0: take it from camera_info)");
+  if (!(p.fy >= 0.0) || !std::isfinite(p.fy)) fatalParameter(name_, "fy", "must be >= 0");
+  if (!(p.initial_altitude >= 0.0) || !std::isfinite(p.initial_altitude)) fatalParameter(name_, "initial_altitude", "must be >= 0 m (0: unknown)");
+  if (!(p.time_jump_tolerance > 0.0)) fatalParameter(name_, "time_jump_tolerance", "must be > 0 s");
+  if (!(p.diagnostics_period > 0.0)) fatalParameter(name_, "diagnostics_period", "must be > 0 s");
+  if (!(p.min_rate > 0.0) || !(p.max_rate >= p.min_rate)) fatalParameter(name_, "min_rate", "need 0 < min_rate <= max_rate");
+}
+
+EstimatorConfig OdometryRos::loadEstimatorConfig() {
+  // The estimator's parameters live in the same YAML file as oefmt_offline's, loaded into the
+  // private namespace by the launch file; every key not given keeps its default.
+  try {
+    const std::string yaml = estimatorYamlFromParameters(private_nh_);
+    return parseConfigText(yaml, "parameters of " + private_nh_.getNamespace());
+  } catch (const InputError& e) {
+    const std::string message = name_ + ": " + e.what();
+    ROS_FATAL_STREAM(message);
+    throw;
+  }
+}
+
+void OdometryRos::imageCallback(const sensor_msgs::ImageConstPtr& message) {
+  InputFrame frame;
+  frame.image = message;
+  frame.stamp = message->header.stamp;
+  frame.frame_id = message->header.frame_id;
+  frame.received = ros::WallTime::now();
+  enqueue(std::move(frame));
+}
+
+void OdometryRos::compressedCallback(const sensor_msgs::CompressedImageConstPtr& message) {
+  InputFrame frame;
+  frame.compressed = message;
+  frame.stamp = message->header.stamp;
+  frame.frame_id = message->header.frame_id;
+  frame.received = ros::WallTime::now();
+  enqueue(std::move(frame));
+}
+
+void OdometryRos::enqueue(InputFrame frame) {
+  ++frames_in_;
+  input_rate_->tick();
+  if (slot_.put(std::move(frame))) {
+    ++frames_dropped_;
+    ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": frames arrive faster than they are processed;"
+                                               " the newest wins (" << frames_dropped_.load()
+                                               << " dropped so far)");
+  }
+}
+
+void OdometryRos::cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& message) {
+  std::lock_guard<std::mutex> lock(camera_mutex_);
+  camera_info_ = message;
+}
+
+void OdometryRos::altitudeCallback(const sensor_msgs::RangeConstPtr& message) {
+  if (!std::isfinite(message->range) || message->range < message->min_range ||
+      message->range > message->max_range) {
+    return;
+  }
+  std::lock_guard<std::mutex> lock(camera_mutex_);
+  altitude_from_topic_ = message->range;
+}
+
+bool OdometryRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  reset_requested_ = true;
+  slot_.clear();
+  ROS_INFO_STREAM(name_ << ": reset requested");
+  return true;
+}
+
+void OdometryRos::workerLoop() {
+  InputFrame frame;
+  while (slot_.take(frame)) {
+    try {
+      process(frame);
+    } catch (const std::exception& e) {
+      // Nothing may escape the worker: count, report and go on with the next frame.
+      ++frames_rejected_;
+      {
+        std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+        last_problem_ = e.what();
+      }
+      ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": frame skipped: " << e.what());
+    }
+  }
+}
+
+void OdometryRos::resetEstimator(const std::string& why) {
+  ROS_WARN_STREAM(name_ << ": restarting the odometry: " << why);
+  estimator_.reset();
+  stamp_guard_.reset();
+  path_.poses.clear();
+  previous_pose_.reset();
+  input_size_ = cv::Size();
+}
+
+cv::Mat OdometryRos::decode(const InputFrame& frame) {
+  try {
+    return frame.image ? imageFromMessage(*frame.image) : imageFromMessage(*frame.compressed);
+  } catch (const BagError& e) {
+    throw InputError(std::string("cannot use the image: ") + e.what());
+  }
+}
+
+bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image) {
+  if (!input_size_.empty() && image.size() != input_size_) {
+    resetEstimator("the image size changed from " + std::to_string(input_size_.width) + "x" +
+                   std::to_string(input_size_.height) + " to " + std::to_string(image.cols) +
+                   "x" + std::to_string(image.rows));
+  }
+  sensor_msgs::CameraInfoConstPtr info;
+  std::optional<double> altitude_topic;
+  {
+    std::lock_guard<std::mutex> lock(camera_mutex_);
+    info = camera_info_;
+    altitude_topic = altitude_from_topic_;
+  }
+  double fx = parameters_.fx;
+  if (info && info->K[0] > 0.0 && info->K[4] > 0.0) {
+    fx = info->K[0];
+  }
+  if (!(fx > 0.0)) {
+    ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": no intrinsics: publish "
+                                                 << nh_.resolveName("camera_info")
+                                                 << " (with a non-zero K) or set ~fx");
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    last_problem_ = "no camera intrinsics (camera_info missing or zero, ~fx unset)";
+    return false;
+  }
+  // Working-image focal length: the core crops to a square and resizes to N.
+  const double working_fx =
+      fx * estimator_config_.registration.size / std::min(image.cols, image.rows);
+  if (estimator_ && std::fabs(working_fx - estimator_fx_) > 1e-6 * working_fx) {
+    resetEstimator("the focal length changed");
+  }
+  if (!estimator_) {
+    EstimatorConfig config = estimator_config_;
+    config.fx = working_fx;
+    if (parameters_.use_altitude_topic) {
+      if (!altitude_topic) {
+        ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": waiting for a valid "
+                                                    << nh_.resolveName("altitude") << " range");
+        return false;
+      }
+      config.altitude = *altitude_topic;
+    } else if (parameters_.initial_altitude > 0.0) {
+      config.altitude = parameters_.initial_altitude;
+    }
+    estimator_ = std::make_unique<Estimator>(config);
+    estimator_fx_ = working_fx;
+    input_size_ = image.size();
+    ROS_INFO_STREAM(name_ << ": odometry started at " << frame.stamp << " (" << image.cols << "x"
+                          << image.rows << ", fx " << fx << " px, scale "
+                          << (config.altitude > 0.0 ? "metric" : "initial altitude = 1") << ")");
+  }
+  return true;
+}
+
+void OdometryRos::process(const InputFrame& frame) {
+  if (reset_requested_.exchange(false)) resetEstimator("~reset was called");
+  const StampGuard::Verdict verdict = stamp_guard_.check(frame.stamp.toSec());
+  if (verdict == StampGuard::Verdict::kJumpBack) {
+    resetEstimator("time jumped back (bag loop or restarted source)");
+    stamp_guard_.check(frame.stamp.toSec());
+  } else if (verdict != StampGuard::Verdict::kAccept) {
+    ++frames_rejected_;
+    ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": frame dropped: " << toString(verdict) << " ("
+                                               << frame.stamp << ")");
+    return;
+  }
+  cv::Mat image = decode(frame);
+  if (!prepareEstimator(frame, image)) {
+    ++frames_rejected_;
+    return;
+  }
+  undistortIfNeeded(image);
+  const auto start = std::chrono::steady_clock::now();
+  const std::optional<Estimate> estimate = estimator_->push(image, frame.stamp.toSec());
+  last_processing_ms_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (!estimate) return;
+  publish(frame, *estimate);
+}
+
+void OdometryRos::undistortIfNeeded(cv::Mat& image) {
+  sensor_msgs::CameraInfoConstPtr info;
+  {
+    std::lock_guard<std::mutex> lock(camera_mutex_);
+    info = camera_info_;
+  }
+  if (!info || info->K[0] <= 0.0) return;
+  const bool distorted = std::any_of(info->D.begin(), info->D.end(), [](double d) { return d != 0.0; });
+  if (!distorted) return;
+  // Maps are rebuilt only when the calibration or the image size changes.
+  std::ostringstream key;
+  key << image.cols << "x" << image.rows;
+  for (double k : info->K) key << ' ' << k;
+  for (double d : info->D) key << ' ' << d;
+  if (key.str() != undistort_key_) {
+    const cv::Matx33d camera(info->K[0], info->K[1], info->K[2], info->K[3], info->K[4], info->K[5],
+                             info->K[6], info->K[7], info->K[8]);
+    cv::initUndistortRectifyMap(camera, info->D, cv::noArray(), camera, image.size(), CV_16SC2,
+                                undistort_map1_, undistort_map2_);
+    undistort_key_ = key.str();
+  }
+  cv::Mat undistorted;
+  cv::remap(image, undistorted, undistort_map1_, undistort_map2_, cv::INTER_LINEAR);
+  image = undistorted;
+}
+
+void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
+  if (!estimate.pose.finite()) {
+    // The estimator never returns NaN; if it ever did, nothing of it may leave the node.
+    ++registration_failures_;
+    ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": non-finite pose withheld at " << frame.stamp);
+    return;
+  }
+  std_msgs::Header header;
+  header.stamp = frame.stamp;
+  header.frame_id = parameters_.odom_frame;
+  const Pose4* previous = previous_pose_ ? &*previous_pose_ : nullptr;
+  odometry_publisher_.publish(odometryMessage(estimate, previous, header, parameters_.base_frame));
+  previous_pose_ = estimate.pose;
+  if (parameters_.publish_tf) {
+    tf_broadcaster_.sendTransform(transformMessage(estimate.pose, header, parameters_.base_frame));
+  }
+  if (parameters_.path_length > 0) {
+    geometry_msgs::PoseStamped pose;
+    pose.header = header;
+    pose.pose.position.x = estimate.pose.x;
+    pose.pose.position.y = estimate.pose.y;
+    pose.pose.position.z = estimate.pose.z;
+    const auto q = yawQuaternion(estimate.pose.yaw);
+    pose.pose.orientation.x = q[0];
+    pose.pose.orientation.y = q[1];
+    pose.pose.orientation.z = q[2];
+    pose.pose.orientation.w = q[3];
+    path_.header = header;
+    path_.poses.push_back(pose);
+    if (static_cast<int>(path_.poses.size()) > parameters_.path_length) {
+      path_.poses.erase(path_.poses.begin(),
+                        path_.poses.begin() + (path_.poses.size() - parameters_.path_length));
+    }
+    path_publisher_.publish(path_);
+  }
+  if (energy_publisher_.getNumSubscribers() > 0) {
+    energy_publisher_.publish(energyVectorsMessage(estimate, estimator_->logZoomPerBin(),
+                                                   estimator_->shiftPerBin(), header));
+  }
+  publishDebugImages(frame, estimate);
+
+  ++frames_out_;
+  output_rate_->tick();
+  last_confidence_ = estimate.registration12.confidence;
+  if (estimate.loop.status == OptimizerStatus::kFallback) ++optimizer_failures_;
+  if (estimate.state == TrackingState::kPredicted || estimate.state == TrackingState::kHeld ||
+      estimate.state == TrackingState::kRestarted) {
+    ++registration_failures_;
+  }
+  last_latency_ms_ = (ros::WallTime::now() - frame.received).toSec() * 1e3;
+}
+
+void OdometryRos::publishDebugImages(const InputFrame& frame, const Estimate& estimate) {
+  if (energy_image_publisher_.getNumSubscribers() == 0) return;
+  std_msgs::Header header;
+  header.stamp = frame.stamp;
+  header.frame_id = frame.frame_id;
+  const cv::Mat plot = renderEnergyVectors(estimate, estimator_->shiftPerBin());
+  energy_image_publisher_.publish(cv_bridge::CvImage(header, "bgr8", plot).toImageMsg());
+}
+
+void OdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::string problem;
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    problem = last_problem_;
+  }
+  const long in = frames_in_, out = frames_out_;
+  if (in > 0 && out == 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
+                   problem.empty() ? "frames arrive but no odometry is published" : problem);
+  } else if (last_confidence_ < estimator_config_.registration.min_confidence && out > 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "low registration confidence");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK, out > 0 ? "tracking" : "waiting for images");
+  }
+  status.add("frames received", in);
+  status.add("odometry published", out);
+  status.add("frames dropped (newest wins)", frames_dropped_.load());
+  status.add("frames rejected (stamp, encoding, intrinsics)", frames_rejected_.load());
+  status.add("frames not registered (pose predicted or held)", registration_failures_.load());
+  status.add("optimizer fallbacks", optimizer_failures_.load());
+  status.add("processing time of the last frame [ms]", last_processing_ms_.load());
+  status.add("latency of the last frame [ms]", last_latency_ms_.load());
+  status.add("registration confidence", last_confidence_.load());
+  status.add("mode", toString(estimator_config_.mode));
+  if (!problem.empty()) status.add("last problem", problem);
+}
+
+}  // namespace oefmt
