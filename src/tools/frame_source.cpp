@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "frame_source.h"
+
+#include <utility>
+
+#include "oefmt/ros/bag_io.h"
+
+namespace oefmt {
+namespace {
+
+class FolderSource : public FrameSource {
+ public:
+  explicit FolderSource(const std::string& directory) : dataset_(directory) {}
+  std::size_t size() const override { return dataset_.size(); }
+  bool next(SourceFrame& frame) override {
+    if (index_ >= dataset_.size()) return false;
+    frame.index = index_;
+    frame.stamp = static_cast<double>(index_);  // the authors' ground truth is indexed by frame
+    frame.name = dataset_.imageName(index_);
+    frame.image = dataset_.loadImage(index_);
+    ++index_;
+    return true;
+  }
+  Intrinsics intrinsics() const override { return dataset_.intrinsics(); }
+  std::string describe() const override {
+    return dataset_.directory() + " (" + std::to_string(dataset_.size()) + " images " +
+           std::to_string(dataset_.imageSize().width) + "x" +
+           std::to_string(dataset_.imageSize().height) + ")";
+  }
+  const FolderDataset& dataset() const { return dataset_; }
+
+ private:
+  FolderDataset dataset_;
+  std::size_t index_ = 0;
+};
+
+class BagSource : public FrameSource {
+ public:
+  BagSource(const std::string& path, const std::string& image_topic,
+            const std::string& camera_info_topic)
+      : path_(path), reader_(path, image_topic, camera_info_topic) {}
+  std::size_t size() const override { return reader_.size(); }
+  bool next(SourceFrame& frame) override {
+    BagFrame bag_frame;
+    if (!reader_.next(bag_frame)) return false;
+    frame.index = index_++;
+    frame.stamp = bag_frame.stamp;
+    frame.name = reader_.imageTopic() + " message " + std::to_string(frame.index);
+    frame.image = bag_frame.image;
+    return true;
+  }
+  Intrinsics intrinsics() const override {
+    return reader_.hasCamera() ? reader_.camera().intrinsics : Intrinsics{};
+  }
+  std::string describe() const override {
+    return path_ + " (" + std::to_string(reader_.size()) + " messages on " + reader_.imageTopic() +
+           (reader_.hasCamera() ? ", intrinsics from " + reader_.cameraInfoTopic() : "") + ")";
+  }
+
+ private:
+  std::string path_;
+  BagImageReader reader_;
+  std::size_t index_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> openFolder(const std::string& directory) {
+  return std::make_unique<FolderSource>(directory);
+}
+
+std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string& image_topic,
+                                     const std::string& camera_info_topic) {
+  return std::make_unique<BagSource>(path, image_topic, camera_info_topic);
+}
+
+PrefetchingSource::PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth)
+    : source_(std::move(source)), depth_(depth == 0 ? 1 : depth) {
+  thread_ = std::thread(&PrefetchingSource::run, this);
+}
+
+PrefetchingSource::~PrefetchingSource() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+void PrefetchingSource::run() {
+  for (;;) {
+    SourceFrame frame;
+    bool more = false;
+    std::exception_ptr error;
+    try {
+      more = source_->next(frame);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (error || !more) {
+      error_ = error;
+      finished_ = true;
+      changed_.notify_all();
+      return;
+    }
+    changed_.wait(lock, [this] { return queue_.size() < depth_ || stopping_; });
+    if (stopping_) return;
+    queue_.push_back(std::move(frame));
+    changed_.notify_all();
+  }
+}
+
+bool PrefetchingSource::next(SourceFrame& frame) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [this] { return !queue_.empty() || finished_; });
+  if (!queue_.empty()) {
+    frame = std::move(queue_.front());
+    queue_.pop_front();
+    changed_.notify_all();
+    return true;
+  }
+  if (error_) std::rethrow_exception(error_);
+  return false;
+}
+
+}  // namespace oefmt

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Frames for oefmt_offline from a dataset folder or a bag, decoded on a background thread so
+// that PNG/JPEG decoding overlaps the estimation (a bounded queue: memory stays flat).
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <opencv2/core.hpp>
+
+#include "oefmt/dataset.h"
+
+namespace oefmt {
+
+struct SourceFrame {
+  std::size_t index = 0;
+  double stamp = 0.0;    ///< TUM time: frame index for folders, header stamp [s] for bags
+  cv::Mat image;
+  std::string name;      ///< file name or "bag message k"
+};
+
+/// Where frames come from. next() throws (with the file or bag named) on an unreadable frame.
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual std::size_t size() const = 0;
+  virtual bool next(SourceFrame& frame) = 0;
+  /// Intrinsics of the images (not of the working size); invalid when unknown.
+  virtual Intrinsics intrinsics() const = 0;
+  virtual std::string describe() const = 0;
+};
+
+std::unique_ptr<FrameSource> openFolder(const std::string& directory);
+std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string& image_topic,
+                                     const std::string& camera_info_topic);
+
+/// Reads ahead from a source on its own thread, at most `depth` frames.
+class PrefetchingSource {
+ public:
+  PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth = 4);
+  ~PrefetchingSource();
+  PrefetchingSource(const PrefetchingSource&) = delete;
+  PrefetchingSource& operator=(const PrefetchingSource&) = delete;
+
+  /// The next frame; false at the end. Rethrows the reader's error at the frame it happened.
+  bool next(SourceFrame& frame);
+  const FrameSource& source() const { return *source_; }
+
+ private:
+  void run();
+
+  std::unique_ptr<FrameSource> source_;
+  std::size_t depth_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<SourceFrame> queue_;
+  bool finished_ = false;
+  bool stopping_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;
+};
+
+}  // namespace oefmt

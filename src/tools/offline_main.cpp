@@ -1,0 +1,240 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// oefmt_offline: runs the estimator over a dataset folder or a bag as fast as the CPU allows and
+// writes the trajectory (TUM), optional per-frame diagnostics (CSV) and a summary.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "frame_source.h"
+#include "oefmt/error.h"
+#include "oefmt/estimator.h"
+#include "oefmt/estimator_config.h"
+#include "oefmt/image_prep.h"
+#include "oefmt/ros/bag_io.h"
+#include "oefmt/sim/progress.h"
+#include "oefmt/trajectory.h"
+
+namespace {
+
+const char* const kUsage =
+    "usage: oefmt_offline (--images DIR | --bag FILE [--image-topic T] [--camera-info-topic T])\n"
+    "                     --output TRAJ.tum [--diagnostics FILE.csv] [--config FILE.yaml]\n"
+    "                     [--mode oefmt|efmt|fmt] [--altitude M] [--fx PX] [--max-frames N]\n"
+    "                     [--quiet]\n"
+    "\n"
+    "  --images DIR          a folder in the o-eFMT authors' layout (Images/, imageList.txt,\n"
+    "                        cam_param.yaml, optional timestamps.txt)\n"
+    "  --bag FILE            a ROS 1 bag with sensor_msgs/Image or CompressedImage\n"
+    "  --image-topic T       image topic in the bag (default: its only image topic)\n"
+    "  --camera-info-topic T CameraInfo topic (default: <image namespace>/camera_info if present;\n"
+    "                        '-' ignores intrinsics)\n"
+    "  --output FILE         trajectory, TUM 't x y z qx qy qz qw' (t: frame index for folders,\n"
+    "                        header stamp [s] for bags); REP-103 world: x right, y up of the\n"
+    "                        first image, z up\n"
+    "  --diagnostics FILE    one CSV line per frame: registration, matching, optimizer, timing\n"
+    "  --config FILE         parameters (config/default.yaml documents every key)\n"
+    "  --mode M              overrides the config's mode\n"
+    "  --altitude M          altitude above the dominant plane at the first frame [m]: metric\n"
+    "                        output (otherwise units of the initial altitude)\n"
+    "  --fx PX               focal length of the images [px] (overrides cam_param/CameraInfo)\n"
+    "  --max-frames N        stop after N frames\n"
+    "  --quiet               no progress bar and no summary table\n"
+    "Exit status: 0 done, 1 an input could not be read (the trajectory so far is kept), 2 usage.\n";
+
+struct Options {
+  std::string images, bag, image_topic, camera_info_topic, output, diagnostics, config, mode;
+  double altitude = -1.0;
+  double fx = 0.0;
+  long max_frames = -1;
+  bool quiet = false;
+};
+
+[[noreturn]] void usageError(const std::string& message) {
+  std::fprintf(stderr, "oefmt_offline: %s\n\n%s", message.c_str(), kUsage);
+  std::exit(2);
+}
+
+double parseNumber(const std::string& option, const char* text) {
+  char* end = nullptr;
+  const double value = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(value)) {
+    usageError(option + " needs a number, got '" + text + "'");
+  }
+  return value;
+}
+
+Options parseArguments(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) usageError(arg + " needs a value");
+      return argv[++i];
+    };
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (arg == "--images") o.images = value();
+    else if (arg == "--bag") o.bag = value();
+    else if (arg == "--image-topic") o.image_topic = value();
+    else if (arg == "--camera-info-topic") o.camera_info_topic = value();
+    else if (arg == "--output") o.output = value();
+    else if (arg == "--diagnostics") o.diagnostics = value();
+    else if (arg == "--config") o.config = value();
+    else if (arg == "--mode") o.mode = value();
+    else if (arg == "--altitude") o.altitude = parseNumber(arg, value());
+    else if (arg == "--fx") o.fx = parseNumber(arg, value());
+    else if (arg == "--max-frames") o.max_frames = static_cast<long>(parseNumber(arg, value()));
+    else if (arg == "--quiet") o.quiet = true;
+    else usageError("unknown option '" + arg + "'");
+  }
+  if (o.images.empty() == o.bag.empty()) usageError("give exactly one of --images and --bag");
+  if (o.output.empty()) usageError("--output is required");
+  if (o.altitude != -1.0 && !(o.altitude > 0.0)) usageError("--altitude must be > 0");
+  if (o.fx < 0.0) usageError("--fx must be > 0");
+  return o;
+}
+
+void writeDiagnosticsHeader(std::ostream& out) {
+  out << "frame,stamp,state,degraded,theta_rad,zoom,phi_rad,rho_px,confidence,"
+         "sigma_theta_rad,sigma_log_zoom,sigma_phi_rad,sigma_rho_px,"
+         "pmt12,pmt12_sigma,pmt02,pmt02_sigma,pms12_bins,pms12_sigma,pms02_bins,pms02_sigma,"
+         "lambda_t12,lambda_t02,optimizer_status,optimizer_iterations,cost_initial,cost_final,"
+         "x,y,z,yaw,registration_ms,estimator_ms,total_ms\n";
+}
+
+void writeDiagnosticsLine(std::ostream& out, const oefmt::Estimate& e) {
+  const oefmt::PairRegistration& r = e.registration12;
+  char line[1024];
+  std::snprintf(line, sizeof(line),
+                "%zu,%.9f,%s,%d,%.8f,%.8f,%.8f,%.5f,%.4f,%.8f,%.8f,%.8f,%.5f,"
+                "%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.6f,%.6f,%s,%d,%.6g,%.6g,"
+                "%.6f,%.6f,%.6f,%.8f,%.3f,%.3f,%.3f\n",
+                e.frame_index, e.stamp, oefmt::toString(e.state), e.degraded ? 1 : 0, r.rotation,
+                r.zoom, r.direction, r.shift, r.confidence, r.rotation_sigma, r.log_zoom_sigma,
+                r.direction_sigma, r.shift_sigma, e.pmt12.value, e.pmt12.sigma, e.pmt02.value,
+                e.pmt02.sigma, e.pms12.value, e.pms12.sigma, e.pms02.value, e.pms02.sigma,
+                e.lambda_t12, e.lambda_t02, oefmt::toString(e.loop.status), e.loop.iterations,
+                e.loop.initial_cost, e.loop.final_cost, e.pose.x, e.pose.y, e.pose.z, e.pose.yaw,
+                e.registration_ms, e.estimator_ms, e.total_ms);
+  out << line;
+}
+
+double percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(q * (values.size() - 1) + 0.5));
+  return values[k];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options options = parseArguments(argc, argv);
+  std::ofstream trajectory, diagnostics;
+  long frames = 0, not_tracked = 0, restarts = 0, fallbacks = 0;
+  std::vector<double> frame_ms;
+  double first_stamp = 0.0, last_stamp = 0.0;
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  try {
+    oefmt::EstimatorConfig config =
+        options.config.empty() ? oefmt::EstimatorConfig{} : oefmt::loadConfig(options.config);
+    if (!options.mode.empty()) config.mode = oefmt::parseEstimatorMode(options.mode);
+    if (options.altitude > 0.0) config.altitude = options.altitude;
+
+    std::unique_ptr<oefmt::FrameSource> opened =
+        options.images.empty()
+            ? oefmt::openBag(options.bag, options.image_topic, options.camera_info_topic)
+            : oefmt::openFolder(options.images);
+    // Focal length of the working image: the core crops a centred square and resizes it to N.
+    oefmt::Intrinsics intrinsics = opened->intrinsics();
+    if (options.fx > 0.0) intrinsics.fx = intrinsics.fy = options.fx;
+    const std::string source_text = opened->describe();
+    oefmt::PrefetchingSource source(std::move(opened));
+
+    trajectory.open(options.output);
+    if (!trajectory) throw oefmt::InputError("cannot write '" + options.output + "'");
+    trajectory << "# oefmt_offline " << oefmt::toString(config.mode) << ": t x y z qx qy qz qw ("
+               << (config.altitude > 0.0 ? "metres" : "units of the initial altitude") << ")\n";
+    if (!options.diagnostics.empty()) {
+      diagnostics.open(options.diagnostics);
+      if (!diagnostics) throw oefmt::InputError("cannot write '" + options.diagnostics + "'");
+      writeDiagnosticsHeader(diagnostics);
+    }
+    if (!options.quiet) std::fprintf(stderr, "oefmt_offline: %s, mode %s\n", source_text.c_str(), oefmt::toString(config.mode));
+
+    std::unique_ptr<oefmt::Estimator> estimator;
+    const size_t total = options.max_frames >= 0
+                             ? std::min<size_t>(source.source().size(), options.max_frames)
+                             : source.source().size();
+    oefmt::sim::ProgressBar progress("oefmt_offline", total, options.quiet ? nullptr : stderr);
+    oefmt::SourceFrame frame;
+    while ((options.max_frames < 0 || frames < options.max_frames) && source.next(frame)) {
+      if (!estimator) {
+        if (intrinsics.valid()) {
+          config.fx = intrinsics.fx * config.registration.size /
+                      std::min(frame.image.cols, frame.image.rows);
+        } else if (!options.quiet) {
+          std::fprintf(stderr, "oefmt_offline: no intrinsics (no cam_param.yaml/CameraInfo, no "
+                               "--fx): assuming a 53 degree field of view\n");
+        }
+        estimator = std::make_unique<oefmt::Estimator>(config);
+        first_stamp = frame.stamp;
+      }
+      const std::optional<oefmt::Estimate> estimate = estimator->push(frame.image, frame.stamp);
+      ++frames;
+      if (!estimate) {
+        ++not_tracked;
+        std::fprintf(stderr, "oefmt_offline: %s skipped: its stamp %.9f is not after the previous one\n",
+                     frame.name.c_str(), frame.stamp);
+        continue;
+      }
+      last_stamp = frame.stamp;
+      frame_ms.push_back(estimate->total_ms);
+      if (estimate->state != oefmt::TrackingState::kTracking &&
+          estimate->state != oefmt::TrackingState::kStarted) {
+        ++not_tracked;
+      }
+      if (estimate->state == oefmt::TrackingState::kRestarted) ++restarts;
+      if (estimate->loop.status == oefmt::OptimizerStatus::kFallback) ++fallbacks;
+      trajectory << oefmt::toTumLine(estimate->pose) << '\n';
+      if (diagnostics.is_open()) writeDiagnosticsLine(diagnostics, *estimate);
+      progress.update(static_cast<size_t>(frames));
+    }
+    progress.finish();
+  } catch (const std::exception& e) {
+    // Keep and close what was written so far: a partial trajectory is still a valid file.
+    std::fprintf(stderr, "oefmt_offline: error: %s\n", e.what());
+    status = 1;
+  }
+  trajectory.flush();
+  diagnostics.flush();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!options.quiet) {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double data_s = last_stamp - first_stamp;
+    std::fprintf(stderr,
+                 "frames %ld | not tracked %ld | restarts %ld | optimizer fallbacks %ld\n"
+                 "estimator ms/frame: mean %.2f, median %.2f, p95 %.2f | wall %.2f s = %.2f ms/frame"
+                 " | peak memory %.1f MB",
+                 frames, not_tracked, restarts, fallbacks,
+                 frame_ms.empty() ? 0.0 : std::accumulate(frame_ms.begin(), frame_ms.end(), 0.0) / frame_ms.size(),
+                 percentile(frame_ms, 0.5), percentile(frame_ms, 0.95), wall_s,
+                 frames > 0 ? wall_s * 1e3 / frames : 0.0, usage.ru_maxrss / 1024.0);
+    if (!options.bag.empty() && data_s > 0.0) std::fprintf(stderr, " | real-time factor %.1fx", data_s / wall_s);
+    std::fprintf(stderr, "\n");
+  }
+  return status;
+}
