@@ -63,12 +63,18 @@ FlightPlan planFlight(const FlightOptions& o) {
   }
   plan.poses = makeTrack(plan.track);
   const double altitude = plan.track.altitude;
-  const double ground_pixel = altitude / k.fx;  // [m] at the start altitude
+  // Size of a ground pixel at the mean altitude [m]: sets the block and texture scales, so that a
+  // climbing flight neither blurs its textures at the start nor aliases them at the top.
+  double mean_altitude = 0.0;
+  for (const FlightPose& pose : plan.poses) mean_altitude += pose.position[2];
+  mean_altitude /= static_cast<double>(plan.poses.size());
+  const double ground_pixel = mean_altitude / k.fx;
 
   SceneConfig& scene = plan.scene;
   scene.seed = o.seed;
   std::vector<double> heights = o.level_heights;
   if (heights.empty()) heights = {0.15 * altitude, 0.30 * altitude};
+  if (o.flat) heights.clear();
   scene.levels.clear();
   for (std::size_t l = 0; l < heights.size(); ++l) {
     BlockLevel level;

@@ -49,9 +49,12 @@ camera:
 scene:
   --seed N                   scene and noise seed (default 1)
   --levels H1,H2,...         raised levels' heights [m] (default 0.15 and 0.30 of the altitude)
+  --flat                     ground plane only, no raised levels
   --incline DEG              tilt of the last level's terraces (default 6)
-  --cell M                   block pitch [m] (default 0.22 of the ground footprint width)
-  --texel M                  texture resolution [m] (default half a ground pixel)
+  --cell M                   block pitch [m] (default 0.22 of the ground footprint's width at
+                             the mean altitude)
+  --texel M                  texture resolution [m] (default half a ground pixel at the mean
+                             altitude)
   --texture-size N           procedural texture side [texels] (default 8 x width, <= 4096)
   --texture LAYER=FILE       image file as texture of a layer (0 ground, 1.. levels); repeatable
 rendering and sensor:
@@ -185,6 +188,8 @@ Command parse(int argc, char** argv) {
       f.seed = static_cast<std::uint32_t>(seed);
     } else if (arg == "--levels") {
       f.level_heights = numberList(arg, args.value(arg));
+    } else if (arg == "--flat") {
+      f.flat = true;
     } else if (arg == "--incline") {
       f.incline_deg = args.number(arg);
     } else if (arg == "--cell") {
@@ -253,7 +258,7 @@ void printPlan(const oefmt::sim::FlightPlan& plan, const Command& command) {
               t.heading == oefmt::sim::HeadingMode::kFixed ? "fixed" : "along track", t.yaw / kDeg);
   std::printf("altitude    %.3f m%s, climb %.2f m\n", t.altitude,
               command.flight.track.altitude > 0.0 ? "" : " (from the target overlap)", t.climb);
-  std::printf("camera      %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f, k1 %.4g k2 %.4g, ground pixel %.4f m\n",
+  std::printf("camera      %dx%d, fx %.2f fy %.2f cx %.2f cy %.2f, k1 %.4g k2 %.4g, ground pixel %.4f m at start\n",
               k.width, k.height, k.fx, k.fy, k.cx, k.cy, plan.camera.distortion.k1, plan.camera.distortion.k2,
               t.altitude / k.fx);
   std::printf("scene       seed %u, ground + %zu levels:", plan.scene.seed, plan.scene.levels.size());

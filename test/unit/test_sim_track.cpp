@@ -183,6 +183,15 @@ TEST(SimFlightPlan, EightAndFixedAltitude) {
   EXPECT_GT(plan.ground_overlap.mean, 0.9);
 }
 
+TEST(SimFlightPlan, FlatSceneHasOnlyTheGround) {
+  FlightOptions options;
+  options.flat = true;
+  options.track.altitude = 2.0;  // low is fine without blocks
+  const FlightPlan plan = planFlight(options);
+  EXPECT_TRUE(plan.scene.levels.empty());
+  EXPECT_EQ(plan.scene.highestTop(), 0.0);
+}
+
 TEST(SimFlightPlan, RejectsFlyingBelowTheBlocks) {
   FlightOptions options;
   options.track.altitude = 5.0;

@@ -40,9 +40,10 @@ struct FlightOptions {
   std::uint32_t seed = 1;
   /// Raised levels' heights [m]; empty: 0.15 and 0.30 of the altitude.
   std::vector<double> level_heights;
+  bool flat = false;          ///< ground plane only (no raised levels)
   double incline_deg = 6.0;   ///< tilt of the last level's terraces [deg]
-  double cell_size = 0.0;     ///< block pitch [m]; 0: 0.22 of the ground footprint's width
-  double texel = 0.0;         ///< texture resolution [m]; 0: half a ground pixel at the altitude
+  double cell_size = 0.0;     ///< block pitch [m]; 0: 0.22 of the mean ground footprint's width
+  double texel = 0.0;         ///< texture resolution [m]; 0: half a ground pixel at mean altitude
   int texture_size = 0;       ///< procedural texture side [texels]; 0: 8 * width, at most 4096
   std::vector<std::string> texture_files;  ///< per layer (0 ground, 1.. levels), empty = procedural
   int supersample = 2;        ///< s x s rays per pixel
