@@ -70,7 +70,7 @@ run_tests() {
 
 run_demo() {
   ros_environment
-  "$build/devel/lib/oefmt/oefmt_register_pair"
+  bash "$repo/scripts/demo.sh" "$build" "$build/demo"
 }
 
 case "$command" in
