@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -80,6 +81,17 @@ cv::Mat1f makeTileable(const cv::Mat1f& source, int margin) {
     throw InputError("makeTileable: the source must be larger than twice the margin (>= 1)");
   }
   const double mean = cv::mean(source)[0];
+  // Fade weights: position i < margin continues the source's position `size + i` and turns into
+  // position i; sin^2 + cos^2 = 1 keeps the variance.
+  std::vector<float> keep(margin), fade(margin);
+  for (int i = 0; i < margin; ++i) {
+    const double w = (i + 0.5) / margin * (CV_PI / 2.0);
+    keep[i] = static_cast<float>(std::sin(w));
+    fade[i] = static_cast<float>(std::cos(w));
+  }
+  const auto blend = [&](float near, float far, int i) {
+    return static_cast<float>(mean + keep[i] * (near - mean) + fade[i] * (far - mean));
+  };
   // Columns first (keeping all rows), then rows of that result.
   const int width = source.cols - margin, height = source.rows - margin;
   cv::Mat1f columns(source.rows, width);
@@ -87,21 +99,14 @@ cv::Mat1f makeTileable(const cv::Mat1f& source, int margin) {
     const float* in = source[r];
     float* out = columns[r];
     for (int c = 0; c < width; ++c) out[c] = in[c];
-    for (int c = 0; c < margin; ++c) {
-      // Position c continues the source's column `width + c`: fade from that one into column c.
-      const double w = (c + 0.5) / margin * (CV_PI / 2.0);
-      out[c] = static_cast<float>(mean + std::sin(w) * (in[c] - mean) + std::cos(w) * (in[width + c] - mean));
-    }
+    for (int c = 0; c < margin; ++c) out[c] = blend(in[c], in[width + c], c);
   }
   cv::Mat1f tile = columns.rowRange(0, height).clone();
   for (int r = 0; r < margin; ++r) {
-    const double w = (r + 0.5) / margin * (CV_PI / 2.0);
     const float* near_row = columns[r];
     const float* far_row = columns[height + r];
     float* out = tile[r];
-    for (int c = 0; c < width; ++c) {
-      out[c] = static_cast<float>(mean + std::sin(w) * (near_row[c] - mean) + std::cos(w) * (far_row[c] - mean));
-    }
+    for (int c = 0; c < width; ++c) out[c] = blend(near_row[c], far_row[c], r);
   }
   return tile;
 }

@@ -115,6 +115,27 @@ TEST(SimRender, SeveralDepthsAreInView) {
   EXPECT_GT((counts[1] + counts[2]) / total, 0.05);
 }
 
+TEST(SimRender, FlatLevelPixelsLieOnThatLevelsTops) {
+  const FlightPlan plan = planFlight(smallFlight());
+  const Scene scene(plan.scene);
+  const Renderer renderer(std::make_shared<const Scene>(plan.scene), plan.camera, 1);
+  const double level_height = plan.scene.levels[0].height;
+  const RenderedFrame frame = renderer.render(plan.poses[2]);
+  int checked = 0;
+  for (int v = 0; v < frame.layers.rows; ++v) {
+    for (int u = 0; u < frame.layers.cols; ++u) {
+      if (frame.layers(v, u) != 1) continue;
+      // Where this pixel's ray crosses the level's plane there must be a top of that level.
+      const cv::Point2d xy = pixelOnPlane(plan.camera, plan.poses[2], cv::Point2d(u, v), level_height);
+      double height = -1.0;
+      ASSERT_EQ(scene.layerAt(xy.x, xy.y, &height), 1) << u << ", " << v;
+      EXPECT_DOUBLE_EQ(height, level_height);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
 // A scene with only the ground, for checks of the image axes.
 std::shared_ptr<const Scene> groundOnlyScene() {
   SceneConfig config;
