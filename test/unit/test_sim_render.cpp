@@ -6,7 +6,11 @@
 #include <cmath>
 #include <memory>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "io/temp_dir.h"
+#include "oefmt/dataset.h"
 
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
@@ -238,6 +242,25 @@ TEST(SimSensor, NoiseAndBrightnessAsRequested) {
   sensor.brightness_period = 40.0;
   EXPECT_NEAR(cv::mean(sensorImage(grey, sensor, 1, 10))[0], 255.0 * 0.5 * 1.2, 0.6);
   EXPECT_NEAR(cv::mean(sensorImage(grey, sensor, 1, 30))[0], 255.0 * 0.5 * 0.8, 0.6);
+}
+
+TEST(SimTexture, ImageFilesServeAsLayerTextures) {
+  test::TempDir dir;
+  cv::Mat1b stripes(200, 200);
+  for (int r = 0; r < stripes.rows; ++r) stripes.row(r).setTo(r % 20 < 10 ? 40 : 220);  // rows: north-south
+  cv::imwrite(dir / "stripes.png", stripes);
+  SceneConfig config;
+  config.levels.clear();
+  config.texel = 0.05;
+  config.texture_files = {dir / "stripes.png"};
+  const Scene scene(config);
+  ASSERT_EQ(scene.texture(0).rows, 175);  // made tileable: the margin is folded in
+  // Constant along x (east), alternating along y: the file's rows run south (samples away
+  // from the cross-faded margin of 25 texels).
+  EXPECT_FLOAT_EQ(scene.sample(0, 2.0, -1.76), scene.sample(0, 3.0, -1.76));
+  EXPECT_GT(std::fabs(scene.sample(0, 2.0, -1.76) - scene.sample(0, 2.0, -2.26)), 0.5f);
+  config.texture_files = {dir / "missing.png"};
+  EXPECT_THROW(Scene{config}, DatasetError);
 }
 
 TEST(SimTexture, TileableTexturesHaveNoSeam) {
