@@ -17,6 +17,13 @@ struct ScalarObservation {
   bool usable() const;
 };
 
+/// A 2-D observation of d [px of the newer frame] with its covariance [px^2].
+struct VectorObservation {
+  cv::Point2d value;
+  cv::Matx22d covariance;
+  bool usable() const;
+};
+
 /// Everything measured about one pair of the loop (1-2 or 0-2). Every observation becomes its own
 /// residual block with its own robust loss.
 struct PairObservations {
@@ -29,6 +36,8 @@ struct PairObservations {
   /// component), when its length belongs to another depth layer; kNone = not at all.
   enum class TranslationUse { kVector, kDirection, kNone } translation_use = TranslationUse::kVector;
   std::vector<ScalarObservation> shift;         ///< |d| [px]: PMT prediction, followed layer, ...
+  /// Further (weak) priors on d, e.g. the motion predicted from the previous pair.
+  std::vector<VectorObservation> translation_priors;
 
   /// The observations of a registration: rotation, registration zoom and d (as kVector).
   static PairObservations fromMotion(const PairMotion& motion);
@@ -49,7 +58,7 @@ enum class RobustLoss { kNone, kHuber, kCauchy };
 const char* toString(RobustLoss loss);
 
 struct LocalOptimizerOptions {
-  int max_iterations = 25;                 ///< Levenberg-Marquardt iterations
+  int max_iterations = 50;                 ///< Levenberg-Marquardt iterations
   RobustLoss robust_loss = RobustLoss::kCauchy;  ///< per residual block
   double loss_scale = 2.0;                 ///< residual (in sigmas) where the loss turns robust
   /// Sigma floors of the loop residuals (model error: parallax, rounding) added to the
@@ -58,7 +67,9 @@ struct LocalOptimizerOptions {
   double loop_translation_sigma_relative = 0.002;  ///< of the loop's path length
   double loop_rotation_sigma = 2e-4;       ///< [rad]
   double loop_log_zoom_sigma = 2e-4;       ///< [ln s]
-  double function_tolerance = 1e-9;        ///< relative cost change that counts as converged
+  /// Relative cost change (and relative step) that counts as converged. Robust losses make the
+  /// last iterations converge linearly; 1e-6 stops within 1e-4 px of the minimum.
+  double function_tolerance = 1e-6;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -27,6 +27,9 @@ struct StretchMatchOptions {
   double max_normalised_error = 0.22; ///< (e - e_min) / (e_max - e_min) must stay below this
   double smoothing_sigma = 1.0;       ///< Gaussian smoothing of both vectors first [bins], 0 = off
   double sigma_floor = 0.002;         ///< smallest reported sigma (of ln f)
+  /// Bins below this are cleared in both vectors first: the no-motion peak (a static pattern
+  /// correlating at zero shift) must not decide the stretch.
+  int skip_bins = 0;
 };
 
 /// Stretch factor f with b(j) ~ a(j / f): a motion f times as long stretches the translation

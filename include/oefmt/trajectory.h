@@ -63,6 +63,8 @@ class PoseIntegrator {
   const Pose4& integrate(const PairMotion& step, double stamp);
   /// Keeps the pose (no usable motion for this frame) and adds `extra_covariance`.
   const Pose4& hold(double stamp, const cv::Matx44d& extra_covariance);
+  /// Goes back to an earlier pose (e.g. undoing predictions once the real motion is known).
+  void restore(const Pose4& pose) { pose_ = pose; }
 
   const Pose4& pose() const { return pose_; }
   /// Z_k: current altitude above the reference plane (output units).

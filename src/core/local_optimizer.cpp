@@ -200,6 +200,13 @@ void addPriors(ceres::Problem& problem, double* block, const PairObservations& o
                                loss(), block);
     }
   }
+  for (const VectorObservation& v : obs.translation_priors) {
+    if (!v.usable()) continue;
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<TranslationPrior, 2, kBlock>(
+                                 new TranslationPrior{v.value.x, v.value.y,
+                                                      whitening(toEigen(v.covariance), 1e-6)}),
+                             loss(), block);
+  }
   for (const ScalarObservation& s : obs.shift) {
     if (!s.usable()) continue;
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ShiftPrior, 1, kBlock>(
@@ -244,6 +251,11 @@ bool posteriorCovariance(ceres::Problem& problem, double* x12, double* x02, Eige
 
 bool ScalarObservation::usable() const {
   return std::isfinite(value) && std::isfinite(sigma) && sigma > 0.0;
+}
+
+bool VectorObservation::usable() const {
+  return std::isfinite(value.x) && std::isfinite(value.y) && finite(toEigen(covariance)) &&
+         covariance(0, 0) > 0.0 && covariance(1, 1) > 0.0;
 }
 
 PairObservations PairObservations::fromMotion(const PairMotion& motion) {
@@ -401,6 +413,7 @@ LoopSolution LocalOptimizer::solve(const PairMotion& pair01, const PairObservati
   solver.linear_solver_type = ceres::DENSE_QR;
   solver.max_num_iterations = options_.max_iterations;
   solver.function_tolerance = options_.function_tolerance;
+  solver.parameter_tolerance = options_.function_tolerance;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
   solver.minimizer_progress_to_stdout = false;

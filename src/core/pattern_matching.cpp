@@ -26,13 +26,14 @@ struct Prepared {
 
 // Smooths, clears non-finite or negative entries and measures the vector once. Elements below
 // kSupportFraction of the maximum are left out of every sum: their squares are 1e-8 of the peak's.
-Prepared prepare(const std::vector<float>& v, double smoothing_sigma) {
+Prepared prepare(const std::vector<float>& v, double smoothing_sigma, int skip_bins = 0) {
   Prepared p;
   p.n = static_cast<int>(v.size());
   p.values = v;
   for (float& x : p.values) {
     if (!std::isfinite(x) || x < 0.0f) x = 0.0f;
   }
+  for (int j = 0; j < std::min(skip_bins, p.n); ++j) p.values[j] = 0.0f;
   smoothVector(p.values, smoothing_sigma);
   p.values.resize(p.n + 2, 0.0f);
   const auto top = std::max_element(p.values.begin(), p.values.begin() + p.n);
@@ -150,8 +151,8 @@ MatchResult matchStretch(const std::vector<float>& a_in, const std::vector<float
   result.value = options.init > 0.0 ? options.init : 1.0;
   result.sigma = kInvalidSigma;
   if (!usable(a_in, b_in) || options.steps < 1 || !(options.key > 0.0)) return result;
-  const Prepared a = prepare(a_in, options.smoothing_sigma);
-  const Prepared b = prepare(b_in, options.smoothing_sigma);
+  const Prepared a = prepare(a_in, options.smoothing_sigma, options.skip_bins);
+  const Prepared b = prepare(b_in, options.smoothing_sigma, options.skip_bins);
   if (!(a.sum > 0.0) || !(b.sum > 0.0)) return result;
 
   const int n = a.n;
