@@ -2,6 +2,8 @@
 #include "oefmt/ros/bag_io.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <map>
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/sim/camera_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 
