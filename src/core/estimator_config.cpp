@@ -33,11 +33,17 @@ std::string trimmed(const std::string& s) {
   return s.substr(first, s.find_last_not_of(" \t") - first + 1);
 }
 
+// OpenCV's YAML reader keeps a trailing " # comment" in unquoted strings; YAML ends the value there.
+std::string withoutComment(const std::string& s) {
+  const auto hash = s.find(" #");
+  return hash == std::string::npos ? s : s.substr(0, hash);
+}
+
 // Numbers may arrive as strings: OpenCV's YAML reader keeps "1e-9" (no dot) as text.
 double readDouble(const cv::FileNode& node, const std::string& key) {
   if (node.isInt() || node.isReal()) return static_cast<double>(node);
   if (node.isString()) {
-    const std::string text = trimmed(static_cast<std::string>(node));
+    const std::string text = trimmed(withoutComment(static_cast<std::string>(node)));
     char* end = nullptr;
     errno = 0;
     const double v = std::strtod(text.c_str(), &end);
@@ -57,7 +63,7 @@ bool readBool(const cv::FileNode& node, const std::string& key) {
     const int v = static_cast<int>(node);
     if (v == 0 || v == 1) return v == 1;
   } else if (node.isString()) {
-    const std::string text = trimmed(static_cast<std::string>(node));
+    const std::string text = trimmed(withoutComment(static_cast<std::string>(node)));
     if (text == "true" || text == "True" || text == "TRUE" || text == "yes" || text == "on") return true;
     if (text == "false" || text == "False" || text == "FALSE" || text == "no" || text == "off") return false;
   }
@@ -66,7 +72,7 @@ bool readBool(const cv::FileNode& node, const std::string& key) {
 
 std::string readString(const cv::FileNode& node, const std::string& key) {
   if (!node.isString()) badValue(key, "a string");
-  return trimmed(static_cast<std::string>(node));
+  return trimmed(withoutComment(static_cast<std::string>(node)));
 }
 
 // ---- writing one value -------------------------------------------------------------------
