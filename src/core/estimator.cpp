@@ -347,7 +347,9 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     MultiZoomTranslation mz = s.multi_zoom.analyse(s.f1->spectra, frame.spectra, reg12);
     est.registration_ms += msSince(t);
     if (mz.valid) {
-      double length = refinedArgmax(mz.profile) * shift_per_bin;
+      // The unit length (first pair) is the dominant correlation peak's, as in oefmt's start-up;
+      // later lengths follow it by PMT (or fall back to the fused profile's peak).
+      double length = s.have01 ? refinedArgmax(mz.profile) * shift_per_bin : step.shift();
       double length_sigma = alongTrackSigma(step);
       if (s.have01 && !s.translation01.empty() &&
           s.motion01.shift() >= config_.matching.min_peak_bins * shift_per_bin) {
