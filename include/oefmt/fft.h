@@ -33,14 +33,6 @@ class Fft2d {
   /// image = IFFT(spectrum) * size^2 (unnormalised). spectrum is overwritten (FFTW c2r).
   void inverse(cv::Mat2f& spectrum, cv::Mat1f& image) const;
 
-  /// A pruned inverse for when only some output rows are wanted: first the 1-D inverse
-  /// transforms along the columns (in place, all of them), then inverseRows for the rows needed.
-  void inverseColumns(cv::Mat2f& spectrum) const;
-  /// Rows first_row .. first_row + count - 1 (cyclic) of the inverse, from a spectrum that went
-  /// through inverseColumns: out is count x size, unnormalised like inverse().
-  void inverseRows(const cv::Mat2f& column_transformed, int first_row, int count,
-                   cv::Mat1f& out) const;
-
  private:
   struct Plans;
   int size_;

@@ -15,17 +15,11 @@ namespace oefmt {
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
                           bool half_turn = false);
 
-/// The phase-correlation peak computed from the lowest frequencies only (an M x M correlation
-/// with M = small.size()): a cheap test of which of two hypotheses matches, and a coarse
-/// position of the full-resolution peak.
-struct CoarsePeak {
-  double value = 0.0;  ///< peak height (0..1)
-  int row_shift = 0;   ///< peak row as a signed shift in full-resolution rows (+- N/M/2)
-  int col_shift = 0;   ///< same for columns
-};
-CoarsePeak lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
-                             const Fft2d& small, cv::Mat2f& scratch_spectrum,
-                             cv::Mat1f& scratch_surface);
+/// Height of the phase-correlation peak computed from the lowest frequencies only (an M x M
+/// correlation with M = small.size()): a cheap test of which of two hypotheses matches.
+double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
+                         const Fft2d& small, cv::Mat2f& scratch_spectrum,
+                         cv::Mat1f& scratch_surface);
 
 /// Sums over a surface, gathered while it is written (for the peak-to-sidelobe ratio).
 struct SurfaceStats {
@@ -35,9 +29,6 @@ struct SurfaceStats {
 
 /// surface = fftshift(correlation) / N^2: a shift t peaks at (N/2, N/2) + t. Signed values.
 SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface);
-/// The same for a band of rows of the correlation (from Fft2d::inverseRows): columns are
-/// shifted by N/2 and scaled by 1/N^2; the rows keep their order.
-SurfaceStats centredColumns(const cv::Mat1f& correlation_rows, cv::Mat1f& band);
 
 /// Integer peak of |surface| with a sub-pixel refinement.
 struct SurfacePeak {

@@ -58,9 +58,9 @@ void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Ma
                 static_cast<int>(newer.total()), half_turn ? -1.0f : 1.0f);
 }
 
-CoarsePeak lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
-                             const Fft2d& small, cv::Mat2f& scratch_spectrum,
-                             cv::Mat1f& scratch_surface) {
+double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
+                         const Fft2d& small, cv::Mat2f& scratch_spectrum,
+                         cv::Mat1f& scratch_surface) {
   requireSameShape(newer, older);
   const int n = newer.rows;
   const int m = small.size();
@@ -74,16 +74,8 @@ CoarsePeak lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, boo
   }
   small.inverse(scratch_spectrum, scratch_surface);
   double min_value = 0.0, max_value = 0.0;
-  cv::Point min_at, max_at;
-  cv::minMaxLoc(scratch_surface, &min_value, &max_value, &min_at, &max_at);
-  const bool negative = -min_value > max_value;
-  const cv::Point at = negative ? min_at : max_at;
-  CoarsePeak peak;
-  peak.value = (negative ? -min_value : max_value) / (static_cast<double>(m) * m);
-  const auto to_full = [&](int i) { return (i < m / 2 ? i : i - m) * n / m; };
-  peak.row_shift = to_full(at.y);
-  peak.col_shift = to_full(at.x);
-  return peak;
+  cv::minMaxLoc(scratch_surface, &min_value, &max_value);
+  return std::max(max_value, -min_value) / (static_cast<double>(m) * m);
 }
 
 SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface) {
@@ -96,29 +88,6 @@ SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface) {
     const float* in = correlation[(r + half) % n];
     float* out = surface[r];
     float abs_sum = 0.0f, square_sum = 0.0f;  // per row in float, across rows in double
-#pragma omp simd reduction(+ : abs_sum, square_sum)
-    for (int c = 0; c < n; ++c) {
-      const float v = in[c < half ? c + half : c - half] * scale;
-      out[c] = v;
-      abs_sum += std::fabs(v);
-      square_sum += v * v;
-    }
-    stats.abs_sum += abs_sum;
-    stats.square_sum += square_sum;
-  }
-  return stats;
-}
-
-SurfaceStats centredColumns(const cv::Mat1f& correlation_rows, cv::Mat1f& band) {
-  const int n = correlation_rows.cols;
-  const int half = n / 2;
-  const float scale = 1.0f / (static_cast<float>(n) * static_cast<float>(n));
-  band.create(correlation_rows.rows, n);
-  SurfaceStats stats;
-  for (int r = 0; r < correlation_rows.rows; ++r) {
-    const float* in = correlation_rows[r];
-    float* out = band[r];
-    float abs_sum = 0.0f, square_sum = 0.0f;
 #pragma omp simd reduction(+ : abs_sum, square_sum)
     for (int c = 0; c < n; ++c) {
       const float v = in[c < half ? c + half : c - half] * scale;

@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <cstdio>
-#include <cstdlib>
 
 #include <opencv2/imgproc.hpp>
 
@@ -17,18 +15,19 @@
 namespace oefmt {
 namespace {
 
-// Peak-to-sidelobe ratios mapped to a 0..1 confidence: unrelated textures give about 15 at
-// N = 512, a clean registration well above 20.
-constexpr double kPsrFloor = 20.0;
-constexpr double kPsrGood = 60.0;
+// Peak-to-sidelobe ratios mapped to a 0..1 confidence. The translation surface decides: after
+// the warp it only peaks when rotation and zoom were right too; unrelated textures give about
+// 15 at N = 512, clean registrations hundreds. The rotation/zoom surface weakens long before
+// the registration fails (large shifts change the magnitude spectrum), so it has lower bounds.
+constexpr double kTranslationPsrFloor = 20.0;
+constexpr double kTranslationPsrGood = 60.0;
+constexpr double kRotationZoomPsrFloor = 6.0;
+constexpr double kRotationZoomPsrGood = 20.0;
 
 // Rows of the polar unwrap (and of the rotation/zoom surface) that compete for the energy row:
 // rows further than 10 from the peak are overruled by the peak row anyway (spec 2.4 step 4b).
 constexpr int kPolarBandHalfWidth = 16;
 constexpr int kEnergyRowBand = 12;
-// Rows of the rotation/zoom surface inverted around the coarse peak: the energy band plus the
-// coarse peak's uncertainty (N / 128 / 2 rows at most).
-constexpr int kRotationBandHalfWidth = kEnergyRowBand + 4;
 
 double wrapAngle(double a) {
   a = std::fmod(a + CV_PI, 2.0 * CV_PI);
@@ -57,8 +56,8 @@ cv::Point2d peakWidths(const cv::Mat1f& surface, const SurfacePeak& peak, bool c
           gaussianWidth(along_rows, 2 * kRadius + 1, kRadius + peak.sub_row - peak.row, kRadius, false)};
 }
 
-double confidenceFrom(double psr) {
-  return std::clamp((psr - kPsrFloor) / (kPsrGood - kPsrFloor), 0.0, 1.0);
+double confidenceFrom(double psr, double floor, double good) {
+  return std::clamp((psr - floor) / (good - floor), 0.0, 1.0);
 }
 
 }  // namespace
@@ -107,12 +106,7 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     return result;
   }
   const double psr_rotation_zoom = registerRotationZoom(older, newer, method, result);
-  if (surfaces != nullptr) {
-    // The registration inverts only a band of rows: the full surface costs one more FFT.
-    normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
-    context_->fft().inverse(cross_power_, correlation_);
-    centredSurface(correlation_, surfaces->rotation_zoom);
-  }
+  if (surfaces != nullptr) surfaces->rotation_zoom = surface_.clone();
   const double psr_translation = registerTranslation(older, newer, method, result);
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
@@ -120,8 +114,9 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
         method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
     surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
   }
-  if (std::getenv("OEFMT_DEBUG_PSR")) std::fprintf(stderr, "psr rz %.2f t %.2f\n", psr_rotation_zoom, psr_translation);
-  result.confidence = std::min(confidenceFrom(psr_rotation_zoom), confidenceFrom(psr_translation));
+  result.confidence =
+      std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
+               confidenceFrom(psr_translation, kTranslationPsrFloor, kTranslationPsrGood));
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
@@ -132,20 +127,15 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
                                      RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
-  // Every depth of the scene shares one rotation, so everything of interest lies in a band of
-  // rows around the peak: find it at low resolution, then invert only those rows.
-  const CoarsePeak coarse =
-      lowResolutionPeak(newer.log_polar_spectrum, older.log_polar_spectrum, false,
-                        context_->smallFft(), small_spectrum_, small_surface_);
-  const int band_first_row = n / 2 + coarse.row_shift - kRotationBandHalfWidth;
-  context_->fft().inverseColumns(cross_power_);
-  context_->fft().inverseRows(cross_power_, band_first_row - n / 2, 2 * kRotationBandHalfWidth + 1,
-                              correlation_);
-  const SurfaceStats stats = centredColumns(correlation_, surface_);
+  // The full surface: a coarse low-resolution search for the rotation row (to invert only a
+  // band of rows) picked wrong rows on simulated flights, where much of the log-polar
+  // correlation's energy sits at high frequencies.
+  context_->fft().inverse(cross_power_, correlation_);
+  const SurfaceStats stats = centredSurface(correlation_, surface_);
   const SurfacePeak peak = findPeak(surface_, true);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
-  result.rotation = (band_first_row + peak.sub_row - n / 2) * CV_PI / n;
+  result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
   result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
   result.rotation_zoom_peak = peak.value;
   if (method == RegistrationMethod::kEnergyVectors) {
@@ -178,11 +168,9 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
     // hypothesis needs no second warp; a low-resolution correlation decides between the two
     // and only the winner gets the full-size inverse FFT.
     const double same = lowResolutionPeak(newer.spectrum, warped_spectrum_, false,
-                                          context_->smallFft(), small_spectrum_,
-                          small_surface_).value;
+                                          context_->smallFft(), small_spectrum_, small_surface_);
     const double turned = lowResolutionPeak(newer.spectrum, warped_spectrum_, true,
-                                            context_->smallFft(), small_spectrum_,
-                          small_surface_).value;
+                                            context_->smallFft(), small_spectrum_, small_surface_);
     if (turned > same) {
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
