@@ -57,6 +57,11 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
   estimator_config_ = loadEstimatorConfig();
   stamp_guard_ = StampGuard(parameters_.time_jump_tolerance);
   ROS_INFO_STREAM(name_ << ": effective estimator configuration:\n" << configToYaml(estimator_config_));
+  {
+    // Plan the FFTs now (FFTW keeps what it measured for later plans of the same size): the
+    // first frame must not stall the stream for the second or two planning takes.
+    const SpectralContext warm_up(estimator_config_.registration);
+  }
 
   odometry_publisher_ = nh_.advertise<nav_msgs::Odometry>("odom", 20);
   if (parameters_.path_length > 0) path_publisher_ = nh_.advertise<nav_msgs::Path>("path", 2);
@@ -181,8 +186,11 @@ void OdometryRos::enqueue(InputFrame frame) {
 }
 
 void OdometryRos::cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& message) {
-  std::lock_guard<std::mutex> lock(camera_mutex_);
-  camera_info_ = message;
+  {
+    std::lock_guard<std::mutex> lock(camera_mutex_);
+    camera_info_ = message;
+  }
+  camera_ready_.notify_all();
 }
 
 void OdometryRos::altitudeCallback(const sensor_msgs::RangeConstPtr& message) {
@@ -244,7 +252,12 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
   sensor_msgs::CameraInfoConstPtr info;
   std::optional<double> altitude_topic;
   {
-    std::lock_guard<std::mutex> lock(camera_mutex_);
+    // A camera driver or bag publishes image and camera_info together, but the image callback
+    // may run first: give the first camera_info a moment before calling it missing.
+    std::unique_lock<std::mutex> lock(camera_mutex_);
+    if (!camera_info_ && !(parameters_.fx > 0.0)) {
+      camera_ready_.wait_for(lock, std::chrono::seconds(1), [this] { return camera_info_ != nullptr; });
+    }
     info = camera_info_;
     altitude_topic = altitude_from_topic_;
   }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -107,6 +108,7 @@ class OdometryRos {
 
   // Camera model: guarded by camera_mutex_ (written by callbacks, read by the worker).
   std::mutex camera_mutex_;
+  std::condition_variable camera_ready_;
   sensor_msgs::CameraInfoConstPtr camera_info_;
   std::optional<double> altitude_from_topic_;
 
