@@ -120,8 +120,7 @@ void OdometryRos::loadParameters() {
   p.compressed = param(private_nh_, "compressed", p.compressed);
   p.queue_size = param(private_nh_, "queue_size", p.queue_size);
   p.path_length = param(private_nh_, "path_length", p.path_length);
-  p.fx = param(private_nh_, "fx", p.fx);
-  p.fy = param(private_nh_, "fy", p.fy);
+  p.camera_fx = param(private_nh_, "camera_fx", p.camera_fx);
   p.initial_altitude = param(private_nh_, "initial_altitude", p.initial_altitude);
   p.use_altitude_topic = param(private_nh_, "use_altitude_topic", p.use_altitude_topic);
   p.time_jump_tolerance = param(private_nh_, "time_jump_tolerance", p.time_jump_tolerance);
@@ -135,8 +134,7 @@ void OdometryRos::loadParameters() {
   if (!p.camera_frame.empty() && !validFrameName(p.camera_frame)) fatalParameter(name_, "camera_frame", "must not start with '/'");
   if (p.queue_size < 1 || p.queue_size > 100) fatalParameter(name_, "queue_size", "must be in [1, 100]");
   if (p.path_length < 0) fatalParameter(name_, "path_length", "must be >= 0");
-  if (!(p.fx >= 0.0) || !std::isfinite(p.fx)) fatalParameter(name_, "fx", "must be >= 0 (0: take it from camera_info)");
-  if (!(p.fy >= 0.0) || !std::isfinite(p.fy)) fatalParameter(name_, "fy", "must be >= 0");
+  if (!(p.camera_fx >= 0.0) || !std::isfinite(p.camera_fx)) fatalParameter(name_, "camera_fx", "must be >= 0 px (0: take it from camera_info)");
   if (!(p.initial_altitude >= 0.0) || !std::isfinite(p.initial_altitude)) fatalParameter(name_, "initial_altitude", "must be >= 0 m (0: unknown)");
   if (!(p.time_jump_tolerance > 0.0)) fatalParameter(name_, "time_jump_tolerance", "must be > 0 s");
   if (!(p.diagnostics_period > 0.0)) fatalParameter(name_, "diagnostics_period", "must be > 0 s");
@@ -255,27 +253,29 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     // A camera driver or bag publishes image and camera_info together, but the image callback
     // may run first: give the first camera_info a moment before calling it missing.
     std::unique_lock<std::mutex> lock(camera_mutex_);
-    if (!camera_info_ && !(parameters_.fx > 0.0)) {
+    if (!camera_info_ && !(parameters_.camera_fx > 0.0) && !(estimator_config_.fx > 0.0)) {
       camera_ready_.wait_for(lock, std::chrono::seconds(1), [this] { return camera_info_ != nullptr; });
     }
     info = camera_info_;
     altitude_topic = altitude_from_topic_;
   }
-  double fx = parameters_.fx;
+  double fx = parameters_.camera_fx;
   if (info && info->K[0] > 0.0 && info->K[4] > 0.0) {
     fx = info->K[0];
   }
-  if (!(fx > 0.0)) {
+  // Working-image focal length: the core crops to a square and resizes to N. Without camera
+  // intrinsics, the YAML's own (working-image) fx is the last resort.
+  const double working_fx = fx > 0.0
+                                ? fx * estimator_config_.registration.size / std::min(image.cols, image.rows)
+                                : estimator_config_.fx;
+  if (!(working_fx > 0.0)) {
     ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": no intrinsics: publish "
                                                  << nh_.resolveName("camera_info")
-                                                 << " (with a non-zero K) or set ~fx");
+                                                 << " (with a non-zero K) or set ~camera_fx");
     std::lock_guard<std::mutex> lock(diagnostics_mutex_);
-    last_problem_ = "no camera intrinsics (camera_info missing or zero, ~fx unset)";
+    last_problem_ = "no camera intrinsics (camera_info missing or zero, ~camera_fx unset)";
     return false;
   }
-  // Working-image focal length: the core crops to a square and resizes to N.
-  const double working_fx =
-      fx * estimator_config_.registration.size / std::min(image.cols, image.rows);
   if (estimator_ && std::fabs(working_fx - estimator_fx_) > 1e-6 * working_fx) {
     resetEstimator("the focal length changed");
   }
@@ -296,7 +296,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     estimator_fx_ = working_fx;
     input_size_ = image.size();
     ROS_INFO_STREAM(name_ << ": odometry started at " << frame.stamp << " (" << image.cols << "x"
-                          << image.rows << ", fx " << fx << " px, scale "
+                          << image.rows << ", working fx " << working_fx << " px, scale "
                           << (config.altitude > 0.0 ? "metric" : "initial altitude = 1") << ")");
   }
   return true;

@@ -43,8 +43,9 @@ struct RosParameters {
   bool compressed = false;           ///< subscribe to image/compressed instead of image
   int queue_size = 2;                ///< subscriber queue of image, camera_info
   int path_length = 2000;            ///< poses kept in the published path (0 = no path)
-  double fx = 0.0;                   ///< focal length [px] of the camera image when no camera_info
-  double fy = 0.0;                   ///< (unused by 4-DOF odometry; kept for symmetry and checks)
+  /// Focal length [px] of the camera images, used when no camera_info arrives. (Not the YAML's
+  /// `fx`, which is the working image's and is set from this or from camera_info.)
+  double camera_fx = 0.0;
   double initial_altitude = 0.0;     ///< altitude above the dominant plane at start [m], 0 = unknown
   bool use_altitude_topic = false;   ///< take the initial altitude from the `altitude` Range topic
   double time_jump_tolerance = 1.0;  ///< a stamp this far back [s] resets (bag loop)
