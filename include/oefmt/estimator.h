@@ -62,8 +62,10 @@ struct Estimate {
   double lambda_t12 = 0.0;  ///< |d12| / |d01| of the integrated motion
   double lambda_t02 = 0.0;  ///< |d02| / |d01| of the optimized 0-2 (0 without a loop)
 
-  double registration_ms = 0.0;  ///< spectra and registrations
-  double estimator_ms = 0.0;     ///< matching, optimizer and bookkeeping
+  double registration_ms = 0.0;  ///< spectra and registrations (efmt: with the multi-zoom profiles)
+  double matching_ms = 0.0;      ///< pattern matching (part of estimator_ms)
+  double optimizer_ms = 0.0;     ///< local optimizer (part of estimator_ms)
+  double estimator_ms = 0.0;     ///< everything but registration: matching, optimizer, bookkeeping
   double total_ms = 0.0;
 };
 

@@ -66,7 +66,7 @@ struct LocalOptimizerOptions {
   double loop_translation_sigma = 0.05;    ///< [px of frame 0]
   double loop_translation_sigma_relative = 0.002;  ///< of the loop's path length
   double loop_rotation_sigma = 2e-4;       ///< [rad]
-  double loop_log_zoom_sigma = 2e-4;       ///< [ln s]
+  double loop_log_zoom_sigma = 1e-3;       ///< [ln s]: zoom biases differ between baselines
   /// Relative cost change (and relative step) that counts as converged. Robust losses make the
   /// last iterations converge linearly; 1e-6 stops within 1e-4 px of the minimum.
   double function_tolerance = 1e-6;

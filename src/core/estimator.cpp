@@ -267,7 +267,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     est.pose = s.integrator.pose();
     est.total_ms = prepare_ms + msSince(start);
     est.estimator_ms = std::max(0.0, est.total_ms - est.registration_ms);
-    return est;
+    return std::optional<Estimate>(std::move(est));
   };
   const double altitude = s.integrator.altitude();
   const cv::Matx44d held_growth = cv::Matx44d::diag(cv::Vec4d(
@@ -353,11 +353,13 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       double length_sigma = alongTrackSigma(step);
       if (s.have01 && !s.translation01.empty() &&
           s.motion01.shift() >= config_.matching.min_peak_bins * shift_per_bin) {
+        t = Clock::now();
         est.pmt12 = matchStretch(s.translation01, mz.profile,
                                  stretchOptions(config_.matching,
                                                 double(est.frame_gap) / s.gap01,
                                                 config_.matching.stretch_key_12,
                                                 s.motion01.shift() / shift_per_bin));
+        est.matching_ms = msSince(t);
         if (est.pmt12.valid) {
           length = est.pmt12.value * s.motion01.shift();
           length_sigma = std::hypot(length * est.pmt12.sigma,
@@ -389,6 +391,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     const bool stretch_ok = !s.translation01.empty() &&
                             ref.shift >= config_.matching.min_peak_bins * shift_per_bin;
     const MatchingConfig& mc = config_.matching;
+    t = Clock::now();
     if (stretch_ok) {
       const double reference_bin = ref.shift / shift_per_bin;
       est.pmt12 = matchStretch(
@@ -404,6 +407,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       est.pms12 = matchShift(s.zoom01, reg12.zoom_energy, shiftOptions(mc));
       if (usable02) est.pms02 = matchShift(s.zoom01, reg02.zoom_energy, shiftOptions(mc));
     }
+    est.matching_ms = msSince(t);
     PairMotion initial12;
     const PairObservations obs12 =
         observe(reg12, step, est.pmt12, est.pms12, ref, config_, shift_per_bin, log_zoom_per_bin,
@@ -417,7 +421,9 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
           observe(reg02, calibrated(reg02, config_.uncertainty), est.pmt02, est.pms02, ref, config_,
                   shift_per_bin, log_zoom_per_bin, double(gap02) / s.gap01, initial02);
       est.translation_use02 = obs02.translation_use;
+      t = Clock::now();
       est.loop = s.optimizer.solve(s.motion01, obs12, obs02, initial12, initial02);
+      est.optimizer_ms = msSince(t);
       if (est.loop.status == OptimizerStatus::kConverged) {
         step = est.loop.pair12;
         if (ref.shift > 0.0) est.lambda_t02 = est.loop.pair02.shift() / ref.shift;

@@ -61,6 +61,16 @@ struct ScalarPrior {
   }
 };
 
+// r_i = (x_i - value_i) / sigma_i for the whole block.
+struct Anchor {
+  std::array<double, kBlock> value, sigma;
+  template <typename T>
+  bool operator()(const T* x, T* r) const {
+    for (int i = 0; i < kBlock; ++i) r[i] = (x[i] - value[i]) / sigma[i];
+    return true;
+  }
+};
+
 // r = W (d - measured).
 struct TranslationPrior {
   double mx, my;
@@ -214,10 +224,11 @@ void addPriors(ceres::Problem& problem, double* block, const PairObservations& o
                              loss(), block);
   }
   // Anchors, without a robust loss.
-  scalar(kTheta, block[kTheta], kAnchorRotationSigma, nullptr);
-  scalar(kLogZoom, block[kLogZoom], kAnchorLogZoomSigma, nullptr);
-  scalar(kDx, block[kDx], kAnchorShiftSigma, nullptr);
-  scalar(kDy, block[kDy], kAnchorShiftSigma, nullptr);
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Anchor, kBlock, kBlock>(new Anchor{
+                               {block[kTheta], block[kLogZoom], block[kDx], block[kDy]},
+                               {kAnchorRotationSigma, kAnchorLogZoomSigma, kAnchorShiftSigma,
+                                kAnchorShiftSigma}}),
+                           nullptr, block);
 }
 
 // Fills the sigmas of `m` from the posterior covariance of its block (rows offset..offset+3).

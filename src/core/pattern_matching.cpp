@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 
-#include "oefmt/energy_vector.h"
 
 namespace oefmt {
 namespace {
@@ -24,6 +23,38 @@ struct Prepared {
   double sum_sq = 0.0;        // over [lo, end)
 };
 
+// Gaussian smoothing (edges replicated) of v, computed only where v has significant values (the
+// energy vectors are mostly empty, and smoothing the whole vector would dominate the matching).
+void smoothSupport(std::vector<float>& v, int n, double sigma) {
+  if (!(sigma > 0.0) || n < 2) return;
+  const float top = *std::max_element(v.begin(), v.begin() + n);
+  if (!(top > 0.0f)) return;
+  const float threshold = top * 1e-6f;
+  int lo = n, hi = -1;
+  for (int j = 0; j < n; ++j) {
+    if (v[j] > threshold) {
+      lo = std::min(lo, j);
+      hi = j;
+    }
+  }
+  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
+  float kernel[64];
+  const int r = std::min(radius, 31);
+  float norm = 0.0f;
+  for (int i = -r; i <= r; ++i) {
+    kernel[i + r] = static_cast<float>(std::exp(-0.5 * i * i / (sigma * sigma)));
+    norm += kernel[i + r];
+  }
+  const int from = std::max(0, lo - r), to = std::min(n - 1, hi + r);
+  std::vector<float> out(v.begin() + from, v.begin() + to + 1);
+  for (int j = from; j <= to; ++j) {
+    float acc = 0.0f;
+    for (int i = -r; i <= r; ++i) acc += kernel[i + r] * v[std::clamp(j + i, 0, n - 1)];
+    out[j - from] = acc / norm;
+  }
+  std::copy(out.begin(), out.end(), v.begin() + from);
+}
+
 // Smooths, clears non-finite or negative entries and measures the vector once. Elements below
 // kSupportFraction of the maximum are left out of every sum: their squares are 1e-8 of the peak's.
 Prepared prepare(const std::vector<float>& v, double smoothing_sigma, int skip_bins = 0) {
@@ -34,7 +65,7 @@ Prepared prepare(const std::vector<float>& v, double smoothing_sigma, int skip_b
     if (!std::isfinite(x) || x < 0.0f) x = 0.0f;
   }
   for (int j = 0; j < std::min(skip_bins, p.n); ++j) p.values[j] = 0.0f;
-  smoothVector(p.values, smoothing_sigma);
+  smoothSupport(p.values, p.n, smoothing_sigma);
   p.values.resize(p.n + 2, 0.0f);
   const auto top = std::max_element(p.values.begin(), p.values.begin() + p.n);
   p.argmax = static_cast<int>(top - p.values.begin());
