@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "estimator_measurements.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+namespace oefmt {
+namespace detail {
+namespace {
+
+constexpr double kMinRotationSigma = 1e-5;  // [rad]
+constexpr double kMinLogZoomSigma = 1e-5;
+
+double finiteOr(double v, double fallback) { return std::isfinite(v) ? v : fallback; }
+
+}  // namespace
+
+PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
+  PairMotion m;
+  m.rotation = wrapToPi(finiteOr(r.rotation, 0.0));
+  m.log_zoom = r.zoom > 0.0 && std::isfinite(r.zoom) ? std::log(r.zoom) : 0.0;
+  m.translation = {finiteOr(r.translation.x, 0.0), finiteOr(r.translation.y, 0.0)};
+  m.rotation_sigma = std::max(finiteOr(r.rotation_sigma, CV_PI) * u.rotation_scale, kMinRotationSigma);
+  m.log_zoom_sigma = std::max(finiteOr(r.log_zoom_sigma, 1.0) * u.log_zoom_scale, kMinLogZoomSigma);
+  const double shift = m.shift();
+  const double along = std::max(finiteOr(r.shift_sigma, 1e3) * u.shift_scale, kMinShiftSigma);
+  // Below a pixel the direction means little: the along-track sigma holds in every direction.
+  const double across = shift >= 1.0
+                            ? std::max(shift * finiteOr(r.direction_sigma, CV_PI) * u.direction_scale,
+                                       kMinShiftSigma)
+                            : along;
+  m.translation_covariance = alongAcrossCovariance(m.direction(), along, across);
+  return m;
+}
+
+double alongTrackSigma(const PairMotion& m) {
+  const cv::Matx22d& c = m.translation_covariance;
+  const double length = m.shift();
+  if (!(length > 1e-9)) return std::sqrt(std::max(0.5 * (c(0, 0) + c(1, 1)), 0.0));
+  const double ux = m.translation.x / length, uy = m.translation.y / length;
+  return std::sqrt(std::max(ux * ux * c(0, 0) + 2.0 * ux * uy * c(0, 1) + uy * uy * c(1, 1), 0.0));
+}
+
+PairMotion perInterval(const PairMotion& m, int gap) {
+  if (gap <= 1) return m;
+  PairMotion out = m;
+  out.rotation /= gap;
+  out.log_zoom /= gap;
+  out.translation = m.translation * (1.0 / gap);
+  out.translation_covariance = m.translation_covariance * (1.0 / (gap * gap));
+  return out;
+}
+
+StretchMatchOptions stretchOptions(const MatchingConfig& m, double init, double key,
+                                   double reference_bin) {
+  StretchMatchOptions o;
+  o.skip_bins = reference_bin > 4.0 * m.skip_bins ? m.skip_bins : 0;
+  o.steps = m.stretch_steps;
+  o.key = key;
+  o.init = init;
+  o.init_window = m.stretch_init_window;
+  o.max_normalised_error = m.max_normalised_error;
+  o.smoothing_sigma = m.smoothing_sigma;
+  o.sigma_floor = m.stretch_sigma_floor;
+  return o;
+}
+
+ShiftMatchOptions shiftOptions(const MatchingConfig& m) {
+  ShiftMatchOptions o;
+  o.max_shift = m.shift_range;
+  o.step = m.shift_step;
+  o.max_normalised_error = m.max_normalised_error;
+  o.smoothing_sigma = m.smoothing_sigma;
+  o.sigma_floor = m.shift_sigma_floor;
+  return o;
+}
+
+PairObservations observe(const PairRegistration& registration, const PairMotion& measured,
+                         const MatchResult& pmt, const MatchResult& pms, const Reference& ref,
+                         const EstimatorConfig& config, double shift_per_bin,
+                         double log_zoom_per_bin, double intervals, PairMotion& initial) {
+  PairObservations obs = PairObservations::fromMotion(measured);
+  initial = measured;
+  if (config.tracking.motion_prior_sigma > 0.0) {
+    // Pair 0-1's motion continued over this pair's frame intervals.
+    const cv::Point2d predicted = ref.translation * intervals;
+    const double sigma = config.tracking.motion_prior_sigma * cv::norm(predicted) + 1.0;
+    obs.translation_priors.push_back({predicted, cv::Matx22d::eye() * (sigma * sigma)});
+  }
+  if (pms.valid) {
+    obs.log_zoom.push_back({ref.raw_log_zoom - pms.value * log_zoom_per_bin,
+                            std::hypot(pms.sigma * log_zoom_per_bin, ref.raw_log_zoom_sigma)});
+  }
+  if (!pmt.valid) return obs;
+  const double predicted = pmt.value * ref.shift;
+  const double predicted_sigma = std::hypot(predicted * pmt.sigma, pmt.value * ref.shift_sigma);
+  obs.shift.push_back({predicted, predicted_sigma});
+  if (std::fabs(measured.shift() - predicted) <= config.tracking.layer_gate * predicted) return obs;
+
+  obs.translation_use = PairObservations::TranslationUse::kDirection;
+  double length = predicted;
+  double length_sigma = predicted_sigma;
+  const std::optional<double> bin =
+      peakNear(registration.translation_energy, predicted / shift_per_bin,
+               config.tracking.layer_search * predicted / shift_per_bin,
+               config.tracking.layer_min_fraction);
+  if (bin) {
+    // The energy vector's peak is coarser than the correlation peak: twice its sigma.
+    length = *bin * shift_per_bin;
+    length_sigma = 2.0 * alongTrackSigma(measured);
+    obs.shift.push_back({length, length_sigma});
+  }
+  const double direction = measured.direction();
+  initial.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
+  initial.translation_covariance =
+      alongAcrossCovariance(direction, std::max(length_sigma, kMinShiftSigma),
+                            std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0)));
+  return obs;
+}
+
+}  // namespace detail
+}  // namespace oefmt

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Internal to the estimator: registrations and pattern matches turned into calibrated motions and
+// optimizer observations.
+#pragma once
+
+#include "oefmt/estimator_config.h"
+#include "oefmt/local_optimizer.h"
+#include "oefmt/pair_motion.h"
+#include "oefmt/pattern_matching.h"
+#include "oefmt/registration.h"
+
+namespace oefmt {
+namespace detail {
+
+/// Smallest sigma of a shift handed on [px], so that no weight becomes infinite.
+constexpr double kMinShiftSigma = 0.01;
+
+/// A registration as a PairMotion, its peak widths turned into error sigmas (UncertaintyConfig);
+/// non-finite values become "no motion" with wide sigmas.
+PairMotion calibrated(const PairRegistration& registration, const UncertaintyConfig& uncertainty);
+
+/// 1-sigma of |d| (along d) of a motion's translation.
+double alongTrackSigma(const PairMotion& motion);
+
+/// The motion of one frame interval from a motion spanning `gap` intervals.
+PairMotion perInterval(const PairMotion& motion, int gap);
+
+/// PMT options; the no-motion bins are skipped when the reference peak lies well beyond them.
+StretchMatchOptions stretchOptions(const MatchingConfig& matching, double init, double key,
+                                   double reference_bin);
+ShiftMatchOptions shiftOptions(const MatchingConfig& matching);
+
+/// What a pair's observations are related to: pair 0-1 of the window.
+struct Reference {
+  cv::Point2d translation;          ///< d01 [px of frame 1]
+  double shift = 0.0;               ///< |d01|
+  double shift_sigma = 0.0;         ///< its 1-sigma
+  double raw_log_zoom = 0.0;        ///< ln s of the registration that produced S01
+  double raw_log_zoom_sigma = 0.0;
+};
+
+/// The optimizer observations of one pair (1-2 or 0-2) spanning `intervals` times pair 0-1's
+/// frame intervals, and its starting value `initial`:
+/// - the registration (rotation, zoom, d) and, if valid, the PMS zoom relative to S01;
+/// - the PMT length prediction lambda |d01|; a correlation peak whose length is off the
+///   prediction by more than tracking.layer_gate belongs to another depth layer (or is an alias):
+///   only its direction is kept and the translation energy peak nearest to the prediction (the
+///   followed layer) gives the length;
+/// - a weak prior that the pair continues pair 0-1's motion (tracking.motion_prior_sigma).
+PairObservations observe(const PairRegistration& registration, const PairMotion& measured,
+                         const MatchResult& pmt, const MatchResult& pms, const Reference& reference,
+                         const EstimatorConfig& config, double shift_per_bin,
+                         double log_zoom_per_bin, double intervals, PairMotion& initial);
+
+}  // namespace detail
+}  // namespace oefmt
