@@ -31,6 +31,9 @@ constexpr int kDirections = 256;
 
 long long floorIndex(double value) { return static_cast<long long>(std::floor(value)); }
 
+// floor(a / b) for b > 0, exact in integers.
+long long floorDivide(long long a, long long b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
 cv::Mat1f textureFromFile(const std::string& path) {
   const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw DatasetError("cannot read texture image '" + path + "'");
@@ -79,8 +82,12 @@ double SceneConfig::highestTop() const {
 }
 
 Scene::Scene(const SceneConfig& config)
-    : config_(config), seed_hash_(mix(config.seed)), terrace_side_(config.cell_size * config.terrace_cells) {
+    : config_(config), seed_hash_(mix(config.seed)) {
   config_.validate();
+  terrace_side_ = config_.cell_size * config_.terrace_cells;
+  inverse_cell_ = 1.0 / config_.cell_size;
+  inverse_terrace_side_ = 1.0 / terrace_side_;
+  inverse_texel_ = 1.0 / config_.texel;
   const TextureStyle styles[] = {TextureStyle::kCells, TextureStyle::kStripes, TextureStyle::kNoise};
   const int layers = static_cast<int>(config_.levels.size()) + 1;
   textures_.resize(layers);
@@ -98,6 +105,7 @@ Scene::Scene(const SceneConfig& config)
                                    : tileableTexture(size, config_.seed * 7919u + layer, style, feature);
     }
   });
+  for (const cv::Mat1f& texture : textures_) inverse_texture_size_.emplace_back(1.0 / texture.cols, 1.0 / texture.rows);
   double bound = 0.0;
   for (const BlockLevel& level : config_.levels) {
     level_reach_.push_back(config_.levelReach(level));
@@ -127,8 +135,7 @@ int Scene::computeTerraceLevel(long long ti, long long tj) const {
 
 int Scene::computeCellCode(long long ci, long long cj) const {
   if (unit(hash(ci, cj, kCellFilled)) >= config_.fill) return 0;
-  return computeTerraceLevel(floorIndex(static_cast<double>(ci) / config_.terrace_cells),
-                             floorIndex(static_cast<double>(cj) / config_.terrace_cells)) + 1;
+  return computeTerraceLevel(floorDivide(ci, config_.terrace_cells), floorDivide(cj, config_.terrace_cells)) + 1;
 }
 
 void Scene::tabulate() {
@@ -179,13 +186,13 @@ cv::Vec2d Scene::terraceSlope(long long ti, long long tj, int level) const {
 }
 
 int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
-  const double cx = x / config_.cell_size, cy = y / config_.cell_size;
+  const double cx = x * inverse_cell_, cy = y * inverse_cell_;
   const double fci = std::floor(cx), fcj = std::floor(cy);
   const double fx = cx - fci, fy = cy - fcj;
   if (fx < config_.gap || fx > 1.0 - config_.gap || fy < config_.gap || fy > 1.0 - config_.gap) return 0;
   const long long ci = static_cast<long long>(fci), cj = static_cast<long long>(fcj);
-  *ti = floorIndex(fci / config_.terrace_cells);
-  *tj = floorIndex(fcj / config_.terrace_cells);
+  *ti = floorDivide(ci, config_.terrace_cells);
+  *tj = floorDivide(cj, config_.terrace_cells);
   const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
   if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
     return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
@@ -208,14 +215,15 @@ int Scene::layerAt(double x, double y, double* height) const {
 }
 
 SceneHit Scene::cast(const cv::Vec3d& o, const cv::Vec3d& d) const {
+  const double inverse_descent = -1.0 / d[2];
   SceneHit best;
-  best.t = o[2] / -d[2];
+  best.t = o[2] * inverse_descent;
   best.x = o[0] + best.t * d[0];
   best.y = o[1] + best.t * d[1];
-  const double horizontal = std::sqrt(d[0] * d[0] + d[1] * d[1]) / -d[2];
+  const double horizontal = std::sqrt(d[0] * d[0] + d[1] * d[1]) * inverse_descent;
   for (int l = 0; l < static_cast<int>(config_.levels.size()); ++l) {
     const double h = config_.levels[l].height;
-    const double t0 = (o[2] - h) / -d[2];
+    const double t0 = (o[2] - h) * inverse_descent;
     if (t0 <= 0.0) continue;
     const double x0 = o[0] + t0 * d[0], y0 = o[1] + t0 * d[1];
     if (level_reach_[l] == 0.0) {  // flat: the crossing of z = h is the only candidate
@@ -231,10 +239,10 @@ SceneHit Scene::cast(const cv::Vec3d& o, const cv::Vec3d& d) const {
     // Any top of this level lies within level_reach_ of height h, so the ray meets it within
     // `reach` (horizontally) of where it crosses z = h: only terraces that near can be hit.
     const double reach = level_reach_[l] * horizontal;
-    const long long ti_end = floorIndex((x0 + reach) / terrace_side_);
-    const long long tj_end = floorIndex((y0 + reach) / terrace_side_);
-    for (long long ti = floorIndex((x0 - reach) / terrace_side_); ti <= ti_end; ++ti) {
-      for (long long tj = floorIndex((y0 - reach) / terrace_side_); tj <= tj_end; ++tj) {
+    const long long ti_end = floorIndex((x0 + reach) * inverse_terrace_side_);
+    const long long tj_end = floorIndex((y0 + reach) * inverse_terrace_side_);
+    for (long long ti = floorIndex((x0 - reach) * inverse_terrace_side_); ti <= ti_end; ++ti) {
+      for (long long tj = floorIndex((y0 - reach) * inverse_terrace_side_); tj <= tj_end; ++tj) {
         if (terraceLevel(ti, tj) != l) continue;
         const cv::Vec2d slope = terraceSlope(ti, tj, l);
         const double centre_x = (ti + 0.5) * terrace_side_, centre_y = (tj + 0.5) * terrace_side_;
@@ -261,9 +269,11 @@ float Scene::sample(int layer, double x, double y) const {
   const cv::Mat1f& texture = textures_[layer];
   const double w = texture.cols, h = texture.rows;
   // Texture rows run southwards so that a texture looks upright in a yaw-0 image.
-  double u = x / config_.texel, v = -y / config_.texel;
-  u -= std::floor(u / w) * w;
-  v -= std::floor(v / h) * h;
+  double u = x * inverse_texel_, v = -y * inverse_texel_;
+  u -= std::floor(u * inverse_texture_size_[layer][0]) * w;
+  v -= std::floor(v * inverse_texture_size_[layer][1]) * h;
+  if (u < 0.0) u += w;  // rounding of the reciprocal
+  if (v < 0.0) v += h;
   int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
   const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
   if (u0 >= texture.cols) u0 -= texture.cols;  // rounding at the wrap

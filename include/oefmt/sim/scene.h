@@ -106,6 +106,11 @@ class Scene {
   SceneConfig config_;
   std::uint64_t seed_hash_;
   double terrace_side_;
+  // Reciprocals: the per-ray code multiplies instead of dividing.
+  double inverse_cell_;
+  double inverse_terrace_side_;
+  double inverse_texel_;
+  std::vector<cv::Vec2d> inverse_texture_size_;  ///< per layer (1 / cols, 1 / rows)
   std::vector<cv::Mat1f> textures_;
   std::vector<double> level_reach_;   ///< largest |top height - level height| per level [m]
   std::vector<double> level_slope_;   ///< tan(incline) per level
