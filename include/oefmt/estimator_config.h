@@ -65,12 +65,13 @@ struct TrackingConfig {
   void validate() const;
 };
 
-/// The registration's sigmas are peak widths; their errors are a fraction of that (measured on
-/// rendered pairs at N = 256 and 512). These factors turn widths into 1-sigma errors before the
-/// measurements are weighted against each other and propagated into the pose covariance.
+/// The registration's sigmas are peak widths; their errors are a fraction of that (measured for
+/// the energy-vector registration on rendered pairs at N = 256 and 512 and on a simulated
+/// multi-depth flight). These factors turn widths into 1-sigma errors before the measurements are
+/// weighted against each other and propagated into the pose covariance.
 struct UncertaintyConfig {
-  double rotation_scale = 0.2;   ///< theta error / rotation_sigma
-  double log_zoom_scale = 0.05;  ///< ln s error / log_zoom_sigma
+  double rotation_scale = 0.25;  ///< theta error / rotation_sigma
+  double log_zoom_scale = 0.08;  ///< ln s error / log_zoom_sigma
   double shift_scale = 0.1;      ///< error along d / shift_sigma
   double direction_scale = 0.3;  ///< error across d / (shift * direction_sigma)
 
