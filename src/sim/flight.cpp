@@ -98,8 +98,7 @@ FlightPlan planFlight(const FlightOptions& o) {
       y_max = std::max(y_max, static_cast<double>(corner.y));
     }
   }
-  const cv::Rect2d region(x_min, y_min, x_max - x_min, y_max - y_min);
-  scene.region = region;
+  scene.region = cv::Rect2d(x_min, y_min, x_max - x_min, y_max - y_min);
   scene.validate();
 
   if (o.supersample < 1 || o.supersample > 8) throw InputError("supersample must be in [1, 8]");
