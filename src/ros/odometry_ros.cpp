@@ -26,6 +26,7 @@ namespace oefmt {
 namespace {
 
 constexpr double kWarnPeriod = 5.0;  // [s] between repeats of a per-frame warning
+constexpr size_t kLatencyWindow = 200;  // frames in the latency statistics
 
 template <typename T>
 T param(const ros::NodeHandle& nh, const std::string& key, const T& fallback) {
@@ -404,6 +405,9 @@ void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
     ++registration_failures_;
   }
   last_latency_ms_ = (ros::WallTime::now() - frame.received).toSec() * 1e3;
+  std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+  recent_latencies_ms_.push_back(last_latency_ms_);
+  if (recent_latencies_ms_.size() > kLatencyWindow) recent_latencies_ms_.pop_front();
 }
 
 void OdometryRos::publishDebugImages(const InputFrame& frame, const Estimate& estimate) {
@@ -417,10 +421,13 @@ void OdometryRos::publishDebugImages(const InputFrame& frame, const Estimate& es
 
 void OdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   std::string problem;
+  std::vector<double> latencies;
   {
     std::lock_guard<std::mutex> lock(diagnostics_mutex_);
     problem = last_problem_;
+    latencies.assign(recent_latencies_ms_.begin(), recent_latencies_ms_.end());
   }
+  std::sort(latencies.begin(), latencies.end());
   const long in = frames_in_, out = frames_out_;
   if (in > 0 && out == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::ERROR,
@@ -438,6 +445,11 @@ void OdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) 
   status.add("optimizer fallbacks", optimizer_failures_.load());
   status.add("processing time of the last frame [ms]", last_processing_ms_.load());
   status.add("latency of the last frame [ms]", last_latency_ms_.load());
+  if (!latencies.empty()) {
+    // Receipt of the image to publication of its odometry, over the last frames.
+    status.add("latency median [ms]", latencies[latencies.size() / 2]);
+    status.add("latency 95th percentile [ms]", latencies[latencies.size() * 95 / 100]);
+  }
   status.add("registration confidence", last_confidence_.load());
   status.add("mode", toString(estimator_config_.mode));
   if (!problem.empty()) status.add("last problem", problem);

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -133,6 +134,7 @@ class OdometryRos {
   std::atomic<double> last_processing_ms_{0.0}, last_confidence_{1.0}, last_latency_ms_{0.0};
   std::mutex diagnostics_mutex_;
   std::string last_problem_;
+  std::deque<double> recent_latencies_ms_;  ///< receipt -> publish of the last frames (bounded)
   double min_rate_, max_rate_;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> input_rate_, output_rate_;
   ros::Timer diagnostics_timer_;
