@@ -19,6 +19,7 @@ namespace {
 struct EncodingInfo {
   int type;
   bool swap_red_blue;
+  int demosaic = -1;  ///< cv::COLOR_Bayer*2BGR code for Bayer patterns
 };
 
 const std::map<std::string, EncodingInfo>& encodingTable() {
@@ -29,6 +30,16 @@ const std::map<std::string, EncodingInfo>& encodingTable() {
       {"8UC4", {CV_8UC4, false}},    {"bgr16", {CV_16UC3, false}},  {"rgb16", {CV_16UC3, true}},
       {"16UC3", {CV_16UC3, false}},  {"bgra16", {CV_16UC4, false}}, {"rgba16", {CV_16UC4, true}},
       {"16UC4", {CV_16UC4, false}},  {"32FC1", {CV_32FC1, false}},  {"64FC1", {CV_64FC1, false}},
+      // Raw Bayer mosaics, demosaiced to BGR. OpenCV names a pattern by its second row's
+      // start, as cv_bridge maps them: rggb -> BayerBG, bggr -> BayerRG, gbrg -> BayerGR, grbg -> BayerGB.
+      {"bayer_rggb8", {CV_8UC1, false, cv::COLOR_BayerBG2BGR}},
+      {"bayer_bggr8", {CV_8UC1, false, cv::COLOR_BayerRG2BGR}},
+      {"bayer_gbrg8", {CV_8UC1, false, cv::COLOR_BayerGR2BGR}},
+      {"bayer_grbg8", {CV_8UC1, false, cv::COLOR_BayerGB2BGR}},
+      {"bayer_rggb16", {CV_16UC1, false, cv::COLOR_BayerBG2BGR}},
+      {"bayer_bggr16", {CV_16UC1, false, cv::COLOR_BayerRG2BGR}},
+      {"bayer_gbrg16", {CV_16UC1, false, cv::COLOR_BayerGR2BGR}},
+      {"bayer_grbg16", {CV_16UC1, false, cv::COLOR_BayerGB2BGR}},
   };
   return table;
 }
@@ -106,6 +117,10 @@ cv::Mat imageFromMessage(const sensor_msgs::Image& message) {
   if ((message.is_bigendian != 0) != hostIsBigEndian()) swapBytes(image);
   if (info.swap_red_blue) {
     cv::cvtColor(image, image, image.channels() == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGRA);
+  }
+  if (info.demosaic >= 0) {
+    if (rows < 2 || cols < 2) throw BagError("Bayer image smaller than 2x2");
+    cv::cvtColor(image, image, info.demosaic);
   }
   return image;
 }

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <functional>
+#include <map>
 
 #include <opencv2/imgproc.hpp>
 #include <rosbag/bag.h>
@@ -161,6 +162,33 @@ TEST(BagIo, DecodesEveryCommonEncoding) {
   }
   writeImageBag(dir / "big.bag", "mono16", swapped, true);
   EXPECT_EQ(cv::norm(readOnlyFrame(dir / "big.bag"), mono16, cv::NORM_INF), 0.0);
+}
+
+// A uniform colour seen through each Bayer pattern must come back as that colour (a wrong
+// pattern mapping swaps red and blue or mixes in green).
+TEST(BagIo, DemosaicsBayerPatterns) {
+  TempDir dir;
+  const int blue = 30, green = 120, red = 200;
+  // The colour at (row, col) of each pattern: its name lists row 0 (two pixels), then row 1.
+  const std::map<std::string, std::string> patterns = {
+      {"bayer_rggb8", "rggb"}, {"bayer_bggr8", "bggr"}, {"bayer_gbrg8", "gbrg"}, {"bayer_grbg8", "grbg"}};
+  for (const auto& [encoding, layout] : patterns) {
+    cv::Mat1b mosaic(8, 8);
+    for (int r = 0; r < mosaic.rows; ++r) {
+      for (int c = 0; c < mosaic.cols; ++c) {
+        const char colour = layout[(r % 2) * 2 + (c % 2)];
+        mosaic(r, c) = static_cast<unsigned char>(colour == 'r' ? red : colour == 'g' ? green : blue);
+      }
+    }
+    const std::string path = dir / (encoding + ".bag");
+    writeImageBag(path, encoding, mosaic);
+    const cv::Mat image = readOnlyFrame(path);
+    ASSERT_EQ(image.type(), CV_8UC3) << encoding;
+    const cv::Vec3b centre = image.at<cv::Vec3b>(4, 4);
+    EXPECT_NEAR(centre[0], blue, 1) << encoding;
+    EXPECT_NEAR(centre[1], green, 1) << encoding;
+    EXPECT_NEAR(centre[2], red, 1) << encoding;
+  }
 }
 
 void expectBagError(const std::function<void()>& action, const std::string& fragment) {
