@@ -11,6 +11,7 @@
 #include "oefmt/fft.h"
 #include "oefmt/image_prep.h"
 #include "oefmt/remap_table.h"
+#include "oefmt/window.h"
 
 namespace oefmt {
 
@@ -28,7 +29,8 @@ class SpectralContext {
   const Fft2d& smallFft() const { return small_fft_; }
   int halfTurnTestSize() const { return small_fft_.size(); }
 
-  const cv::Mat1f& window() const { return window_; }
+  const SeparableWindow& window() const { return window_; }
+  /// Rows 0 .. N/2 + 1 of the centred high-pass filter: the half plane the log-polar samples.
   const cv::Mat1f& highPass() const { return high_pass_; }
   /// Log-polar radius base b: column j samples radius b^j.
   double logPolarBase() const { return log_polar_base_; }
@@ -39,19 +41,19 @@ class SpectralContext {
   /// (rows: angle 0..-pi, columns: log radius). Bilinear.
   void logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out) const;
   /// Rows first_row .. first_row + count - 1 (cyclic) of the polar unwrap of a centred
-  /// correlation surface (rows: direction 2 pi row / N, columns: radius). Bilinear.
+  /// correlation surface (rows: direction 2 pi row / N, columns: radius). Bilinear, computed
+  /// directly: only a band of rows is ever needed, so no table is kept.
   void polarRows(const cv::Mat1f& centred_surface, int first_row, int count, cv::Mat1f& out) const;
 
  private:
   RegistrationConfig config_;
   Fft2d fft_;
-  cv::Mat1f window_;
+  SeparableWindow window_;
   cv::Mat1f high_pass_;
   double log_polar_base_;
   double polar_radius_step_;
   Fft2d small_fft_;
   BilinearRemapTable log_polar_table_;
-  BilinearRemapTable polar_table_;
 };
 
 /// What the registration needs of one frame; computed once when the frame arrives.
@@ -86,7 +88,7 @@ class SpectraBuilder {
 
 /// Writes rows 0 .. N/2 + 1 of the centred N x N image |spectrum| * filter (DC at (N/2, N/2)):
 /// the half plane the log-polar transform samples (the magnitude is point-symmetric), filling
-/// the columns the real FFT omits by Hermitian symmetry. `filter` is the full N x N filter.
+/// the columns the real FFT omits by Hermitian symmetry. `filter` holds (at least) those rows.
 void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude);
 
 }  // namespace oefmt

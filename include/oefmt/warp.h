@@ -4,12 +4,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/window.h"
+
 namespace oefmt {
 
 /// out(x) = window(x) * bilinear(source, centre + R(-rotation)(x - centre) / zoom), 0 outside
 /// the source: source rotated counter-clockwise on screen by `rotation` [rad] and zoomed by
 /// `zoom` about centre = (N/2, N/2), then apodized. One pass, no intermediate image.
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
-                            const cv::Mat1f& window, cv::Mat1f& out);
+                            const SeparableWindow& window, cv::Mat1f& out);
 
 }  // namespace oefmt

@@ -13,26 +13,10 @@
 namespace oefmt {
 namespace {
 
-// Separable apodization: Hann halves of length 2R at both ends, 1 inside (spec 2.2.1).
-cv::Mat1f makeWindow(int n, double taper_fraction) {
-  const int taper = static_cast<int>(std::floor(taper_fraction * n));
-  std::vector<float> w(n, 1.0f);
-  for (int i = 0; i < taper; ++i) {
-    const float h = static_cast<float>(0.5 - 0.5 * std::cos(2.0 * CV_PI * i / (2.0 * taper - 1.0)));
-    w[i] = h;
-    w[n - 1 - i] = h;
-  }
-  cv::Mat1f window(n, n);
-  for (int r = 0; r < n; ++r) {
-    for (int c = 0; c < n; ++c) window(r, c) = w[r] * w[c];
-  }
-  return window;
-}
-
 // H = 1 - cos^2(|X|) with X sampled so that DC (N/2, N/2) is exactly 0 and the edge is pi/2.
 cv::Mat1f makeHighPass(int n) {
-  cv::Mat1f filter(n, n);
-  for (int r = 0; r < n; ++r) {
+  cv::Mat1f filter(n / 2 + 2, n);  // the half plane the log-polar samples
+  for (int r = 0; r < filter.rows; ++r) {
     const double y = (r - n / 2) * CV_PI / n;
     for (int c = 0; c < n; ++c) {
       const double x = (c - n / 2) * CV_PI / n;
@@ -48,7 +32,7 @@ cv::Mat1f makeHighPass(int n) {
 SpectralContext::SpectralContext(const RegistrationConfig& config)
     : config_((config.validate(), config)),
       fft_(config.size, config.fft_planning),
-      window_(makeWindow(config.size, config.taper_fraction)),
+      window_(config.size, config.taper_fraction),
       high_pass_(makeHighPass(config.size)),
       log_polar_base_(std::pow(config.logpolar_radius_fraction * config.size, 1.0 / config.size)),
       polar_radius_step_(config.polar_radius_fraction),
@@ -63,12 +47,6 @@ SpectralContext::SpectralContext(const RegistrationConfig& config)
     const double radius = std::pow(base, c);
     return cv::Point2d(centre + radius * std::cos(angle), centre + radius * std::sin(angle));
   });
-  const double step = polar_radius_step_;
-  polar_table_ = BilinearRemapTable({n, n}, {n, n}, [&](int r, int c) {
-    const double direction = 2.0 * CV_PI * r / n;
-    const double radius = step * c;
-    return cv::Point2d(centre + radius * std::cos(direction), centre + radius * std::sin(direction));
-  });
 }
 
 void SpectralContext::logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out) const {
@@ -77,7 +55,31 @@ void SpectralContext::logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f&
 
 void SpectralContext::polarRows(const cv::Mat1f& centred_surface, int first_row, int count,
                                 cv::Mat1f& out) const {
-  polar_table_.applyRows(centred_surface, first_row, count, out);
+  const int n = config_.size;
+  if (centred_surface.rows != n || centred_surface.cols != n) {
+    throw InputError("polarRows: surface of the wrong size");
+  }
+  out.create(count, n);
+  const double centre = n / 2;
+  for (int i = 0; i < count; ++i) {
+    const double direction = 2.0 * CV_PI * (first_row + i) / n;
+    const double dx = polar_radius_step_ * std::cos(direction);
+    const double dy = polar_radius_step_ * std::sin(direction);
+    float* row = out[i];
+    for (int c = 0; c < n; ++c) {
+      // Bilinear, 0 outside the surface (no cyclic wrap: radii beyond N/2 are not aliases).
+      const double x = centre + c * dx, y = centre + c * dy;
+      const double x0 = std::floor(x), y0 = std::floor(y);
+      const int xi = static_cast<int>(x0), yi = static_cast<int>(y0);
+      const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+      auto at = [&](int xx, int yy) -> float {
+        return (xx < 0 || yy < 0 || xx >= n || yy >= n) ? 0.0f : centred_surface(yy, xx);
+      };
+      const float top = at(xi, yi) + fx * (at(xi + 1, yi) - at(xi, yi));
+      const float bottom = at(xi, yi + 1) + fx * (at(xi + 1, yi + 1) - at(xi, yi + 1));
+      row[c] = top + fy * (bottom - top);
+    }
+  }
 }
 
 void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude) {
@@ -119,7 +121,7 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   frame.grey = image.grey.isContinuous() ? image.grey : image.grey.clone();
   frame.texture = image.texture;
   frame.invalid_pixels = image.invalid_pixels;
-  cv::multiply(frame.grey, context_->window(), windowed_);
+  context_->window().apply(frame.grey, windowed_);
   context_->fft().forward(windowed_, frame.spectrum);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   context_->logPolar(magnitude_, log_polar_);

@@ -27,8 +27,9 @@ inline float sampleBilinear(const float* src, int stride, int cols, int rows, fl
 }  // namespace
 
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
-                            const cv::Mat1f& window, cv::Mat1f& out) {
-  if (source.empty() || source.size() != window.size() || !(zoom > 0.0) || !source.isContinuous()) {
+                            const SeparableWindow& window, cv::Mat1f& out) {
+  if (source.empty() || source.rows != window.size() || source.cols != window.size() ||
+      !(zoom > 0.0) || !source.isContinuous()) {
     throw InputError("warpSimilarityWindowed: bad source, window or zoom");
   }
   const int rows = source.rows, cols = source.cols;
@@ -46,7 +47,9 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
     // Source point of output (0, y); column x adds x * (a00, a10).
     const float sx0 = static_cast<float>(cx - a00 * cx + a01 * dy);
     const float sy0 = static_cast<float>(cy - a10 * cx + a11 * dy);
-    const float* w = window[y];
+    // Window: taper(y) * taper(x); the row's factor is folded into the taper per column.
+    const float row_weight = window.taper()[y];
+    const float* taper = window.taper().data();
     float* o = out[y];
     int x = 0;
 #if CV_SIMD128
@@ -66,7 +69,9 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
         float sxs[4], sys[4];
         cv::v_store(sxs, sx);
         cv::v_store(sys, sy);
-        for (int k = 0; k < 4; ++k) o[x + k] = w[x + k] * sampleBilinear(src, stride, cols, rows, sxs[k], sys[k]);
+        for (int k = 0; k < 4; ++k) {
+          o[x + k] = row_weight * taper[x + k] * sampleBilinear(src, stride, cols, rows, sxs[k], sys[k]);
+        }
         continue;
       }
       const cv::v_float32x4 fx = sx - cv::v_cvt_f32(ix), fy = sy - cv::v_cvt_f32(iy);
@@ -75,11 +80,12 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
       const cv::v_float32x4 p10 = cv::v_lut(src + stride, index), p11 = cv::v_lut(src + stride + 1, index);
       const cv::v_float32x4 top = p00 + fx * (p01 - p00);
       const cv::v_float32x4 bottom = p10 + fx * (p11 - p10);
-      cv::v_store(o + x, (top + fy * (bottom - top)) * cv::v_load(w + x));
+      cv::v_store(o + x, (top + fy * (bottom - top)) * cv::v_load(taper + x) *
+                             cv::v_setall_f32(row_weight));
     }
 #endif
     for (; x < cols; ++x) {
-      o[x] = w[x] * sampleBilinear(src, stride, cols, rows, sx0 + a00 * x, sy0 + a10 * x);
+      o[x] = row_weight * taper[x] * sampleBilinear(src, stride, cols, rows, sx0 + a00 * x, sy0 + a10 * x);
     }
   }
 }

@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The separable apodization window (spec 2.2.1): stored as one N-vector, not an N x N image.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace oefmt {
+
+class SeparableWindow {
+ public:
+  SeparableWindow() = default;
+  /// Hann halves of length 2R at both ends (R = floor(taper_fraction * n)), 1 inside.
+  SeparableWindow(int n, double taper_fraction);
+
+  int size() const { return static_cast<int>(taper_.size()); }
+  /// w(row, col) = taper(row) * taper(col).
+  float operator()(int row, int col) const { return taper_[row] * taper_[col]; }
+  /// The 1-D taper, one value per row or column.
+  const std::vector<float>& taper() const { return taper_; }
+  /// out = in * w (element-wise); in and out may be the same image.
+  void apply(const cv::Mat1f& in, cv::Mat1f& out) const;
+
+ private:
+  std::vector<float> taper_;
+};
+
+}  // namespace oefmt

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Constants of the spectral tables (algorithm spec section 8, item 6) and the FFT wrapper.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "oefmt/fft.h"
+#include "oefmt/spectra.h"
+#include "oefmt/warp.h"
+#include "support/fixtures.h"
+
+namespace oefmt {
+namespace {
+
+TEST(Spectra, LogPolarBaseSpansTheConfiguredRadius) {
+  const SpectralContext& context = *test::sharedContext(512);
+  EXPECT_NEAR(std::pow(context.logPolarBase(), 512), 0.55 * 512, 1e-6);
+  EXPECT_NEAR(std::log(context.logPolarBase()), 0.011017, 2e-6);
+  EXPECT_DOUBLE_EQ(context.polarRadiusStep(), 0.75);
+}
+
+TEST(Spectra, HighPassIsZeroAtDcAndRisesOutwards) {
+  const SpectralContext& context = *test::sharedContext(512);
+  const cv::Mat1f& h = context.highPass();
+  EXPECT_NEAR(h(256, 256), 0.0f, 1e-7);
+  EXPECT_NEAR(h(256, 0), 1.0f, 1e-6);     // radius pi/2 on the axis
+  EXPECT_NEAR(h(0, 0), std::pow(std::sin(CV_PI / std::sqrt(2.0)), 2), 1e-5);  // corner ~0.63
+  EXPECT_LT(h(256, 250), h(256, 200));
+}
+
+TEST(Spectra, WindowIsOneInsideAndZeroAtTheBorder) {
+  const SpectralContext& context = *test::sharedContext(512);
+  const SeparableWindow& w = context.window();
+  const int taper = static_cast<int>(std::floor(0.12 * 512));
+  EXPECT_EQ(taper, 61);
+  EXPECT_FLOAT_EQ(w(0, 0), 0.0f);
+  EXPECT_FLOAT_EQ(w(511, 300), 0.0f);
+  EXPECT_FLOAT_EQ(w(taper, taper), 1.0f);
+  EXPECT_FLOAT_EQ(w(256, 256), 1.0f);
+  for (int i = 0; i < 512; ++i) EXPECT_FLOAT_EQ(w.taper()[i], w.taper()[511 - i]);  // symmetric
+  EXPECT_GT(w(30, 256), 0.0f);
+  EXPECT_LT(w(30, 256), 1.0f);
+}
+
+TEST(Fft, InverseOfForwardReturnsTheImageTimesNSquared) {
+  const Fft2d fft(64, FftPlanning::kEstimate);
+  cv::Mat1f image(64, 64), back;
+  cv::randu(image, 0.0f, 1.0f);
+  cv::Mat2f spectrum;
+  fft.forward(image, spectrum);
+  EXPECT_EQ(spectrum.cols, 33);
+  fft.inverse(spectrum, back);
+  EXPECT_LT(cv::norm(back / (64.0f * 64.0f), image, cv::NORM_INF), 1e-5);
+}
+
+TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheCentre) {
+  const SeparableWindow flat(64, 0.0);  // no taper: compare raw pixels
+  cv::Mat1f image(64, 64, 0.0f), turned;
+  image(10, 20) = 1.0f;
+  warpSimilarityWindowed(image, CV_PI, 1.0, flat, turned);
+  EXPECT_NEAR(turned(64 - 10, 64 - 20), 1.0f, 1e-4);  // x -> N - x about (N/2, N/2)
+  EXPECT_NEAR(cv::sum(turned)[0], 1.0, 1e-4);
+}
+
+}  // namespace
+}  // namespace oefmt
