@@ -7,7 +7,8 @@ base_link, the energy-vector message, /diagnostics, accuracy against the simulat
 truth, and that the node's trajectory equals oefmt_offline's on the same bag.
 
 Private parameters: ~compressed (bool), ~rate (playback speed factor), ~frames, ~max_ate_mean [m]
-(mean absolute trajectory error after a 2-D similarity alignment), ~compare_offline (bool).
+(mean absolute trajectory error after a 2-D similarity alignment), ~compare_offline (bool),
+~size (image size of the rendered flight).
 """
 import json
 import math
@@ -67,13 +68,14 @@ class ReplayCheck(unittest.TestCase):
         cls.frames = int(rospy.get_param("~frames", 40))
         cls.max_ate_mean = float(rospy.get_param("~max_ate_mean", 0.05))
         cls.compare_offline = rospy.get_param("~compare_offline", True)
+        cls.size = int(rospy.get_param("~size", 256))
         cls.workdir = tempfile.mkdtemp(prefix="oefmt_rostest_")
         cls.flight = os.path.join(cls.workdir, "flight")
         cls.bag = os.path.join(cls.workdir, "flight.bag")
         # A short piece of the default circle (same speed and altitude), multi-depth scene.
         length = 491.0 * cls.frames / 200.0
         run([tool("oefmt_simulate"), "--quiet", "--track", "circle", "--length", str(length),
-             "--frames", str(cls.frames), "--size", "256", "--seed", "3", cls.flight])
+             "--frames", str(cls.frames), "--size", str(cls.size), "--seed", "3", cls.flight])
         if cls.compressed:
             run([tool("oefmt_folder_to_bag"), "--quiet", "--format", "png", cls.flight, cls.bag])
         else:
@@ -166,12 +168,17 @@ class ReplayCheck(unittest.TestCase):
         self.assertTrue(statuses, "no odometry status on /diagnostics")
         self.assertEqual(statuses[-1].level, DiagnosticStatus.OK, statuses[-1].message)
         values = {kv.key: kv.value for kv in statuses[-1].values}
+        rospy.loginfo("replay: latency median %s ms, 95th percentile %s ms, drops %s",
+                      values.get("latency median [ms]"), values.get("latency 95th percentile [ms]"),
+                      values.get("frames dropped (newest wins)"))
         self.assertEqual(values.get("frames dropped (newest wins)"), "0")
 
     def test_accuracy_against_ground_truth(self):
         estimate = os.path.join(self.workdir, "node.tum")
         write_tum(estimate, self.poses())
         result = evaluate(estimate, os.path.join(self.flight, "groundtruth.tum"))
+        rospy.loginfo("replay: node ATE mean %.4f m, max %.4f m, drift %.3f %%", result["ate"]["mean"],
+                      result["ate"]["max"], result["drift_percent"])
         self.assertEqual(result["matched"], self.frames)
         self.assertLess(result["ate"]["mean"], self.max_ate_mean, json.dumps(result))
 
