@@ -87,8 +87,9 @@ struct LoopSolution {
   PairMotion pair12;
   PairMotion pair02;
   OptimizerStatus status = OptimizerStatus::kSkipped;
-  int iterations = 0;
-  double initial_cost = 0.0;
+  int iterations = 0;       ///< summed over all starting points
+  int starts = 0;           ///< starting points solved (3 when the measured loop was open)
+  double initial_cost = 0.0;  ///< of the winning start
   double final_cost = 0.0;
   LoopResiduals before;  ///< loop errors of the initial values
   LoopResiduals after;   ///< loop errors of the result
@@ -101,7 +102,12 @@ struct LoopSolution {
 /// - the translation loop t01 + t12 - t02 = 0 with the camera displacements in frame-0 pixels,
 ///   t_AB = -R(theta) d / s accumulated through the zooms and rotations of the chain;
 /// - the rotation loop theta01 + theta12 - theta02 = 0 and the additive log-zoom loop.
-/// The loops' sigmas come from pair 0-1's uncertainty plus the floors of the options.
+/// The loops' sigmas come from pair 0-1's uncertainty plus the floors of the options. Observation
+/// blocks carry the configured robust loss, the loop blocks a Huber loss (they are geometry and
+/// must keep pulling). When the measured loop does not close (> 3 sigma), one observation is an
+/// outlier and the cost is multi-modal: the solve is repeated from "1-2 recomputed from the loop"
+/// and "0-2 recomputed from the loop", and the cheapest converged solution wins. Converged results
+/// carry posterior sigmas ((J^T J)^-1 at the solution).
 /// Never throws for numeric reasons: non-finite or degenerate inputs give kFallback.
 class LocalOptimizer {
  public:

@@ -439,6 +439,7 @@ LoopSolution LocalOptimizer::solve(const PairMotion& pair01, const PairObservati
     x02 = start.second;
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &problem, &summary);
+    ++solution.starts;
     solution.iterations += static_cast<int>(summary.iterations.size());
     const bool ok = summary.termination_type == ceres::CONVERGENCE && all_finite(x12) &&
                     all_finite(x02) && std::isfinite(summary.final_cost);

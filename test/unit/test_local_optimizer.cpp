@@ -78,6 +78,7 @@ TEST(LocalOptimizer, ConsistentInputsStayAlmostUnchanged) {
   EXPECT_NEAR(s.pair12.log_zoom, loop.p12.log_zoom, 1e-7);
   EXPECT_LT(cv::norm(s.after.translation), 1e-4);
   EXPECT_LT(s.final_cost, 1e-8);
+  EXPECT_EQ(s.starts, 1);  // a closed loop needs no further starting points
   // Posterior sigmas are finite, positive and no larger than the measurements'.
   EXPECT_GT(s.pair12.rotation_sigma, 0.0);
   EXPECT_LE(s.pair12.rotation_sigma, loop.p12.rotation_sigma * 1.0001);
@@ -114,6 +115,7 @@ TEST(LocalOptimizer, AliasedPeakInPairOneTwoIsRecoveredFromTheLoop) {
   EXPECT_LT(distance(s.pair02.translation, truth.p02.translation), 0.3);
   EXPECT_LT(cv::norm(s.after.translation), 0.5);
   EXPECT_GT(cv::norm(s.before.translation), 100.0);
+  EXPECT_EQ(s.starts, 3);
 }
 
 TEST(LocalOptimizer, AliasedPeakInPairZeroTwoIsRecoveredFromTheLoop) {
