@@ -340,9 +340,13 @@ EstimatorConfig loadConfig(const std::string& yaml_path) {
     if (!storage.open(yaml_path, cv::FileStorage::READ)) {
       throw InputError("cannot open configuration file '" + yaml_path + "'");
     }
+  } catch (const InputError&) {
+    throw;
   } catch (const cv::Exception& e) {
     throw InputError("cannot parse configuration file '" + yaml_path +
                      "' (it must start with %YAML:1.0, or %YAML 1.0 and ---): " + e.msg);
+  } catch (const std::exception& e) {  // OpenCV's parser also lets std::length_error out
+    throw InputError("cannot parse configuration file '" + yaml_path + "': " + e.what());
   }
   return parseConfig(storage.root(), yaml_path);
 }
