@@ -62,6 +62,7 @@ struct FrameSpectra {
   cv::Mat2f spectrum;           ///< FFT of the apodized grey image
   cv::Mat2f log_polar_spectrum; ///< FFT of the log-polar high-passed magnitude spectrum
   double texture = 0.0;         ///< grey standard deviation
+  float mean = 0.0f;            ///< grey mean, subtracted before apodization
   int invalid_pixels = 0;       ///< non-finite input pixels that were replaced
 
   bool empty() const { return grey.empty(); }

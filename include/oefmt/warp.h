@@ -8,10 +8,11 @@
 
 namespace oefmt {
 
-/// out(x) = window(x) * bilinear(source, centre + R(-rotation)(x - centre) / zoom), 0 outside
-/// the source: source rotated counter-clockwise on screen by `rotation` [rad] and zoomed by
-/// `zoom` about centre = (N/2, N/2), then apodized. One pass, no intermediate image.
+/// out(x) = window(x) * (bilinear(source, centre + R(-rotation)(x - centre) / zoom) - offset)
+/// inside the source and 0 outside: source rotated counter-clockwise on screen by `rotation`
+/// [rad] and zoomed by `zoom` about centre = (N/2, N/2), less its mean `offset`, then apodized.
+/// One pass, no intermediate image.
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
-                            const SeparableWindow& window, cv::Mat1f& out);
+                            const SeparableWindow& window, cv::Mat1f& out, float offset = 0.0f);
 
 }  // namespace oefmt

@@ -19,8 +19,10 @@ class SeparableWindow {
   float operator()(int row, int col) const { return taper_[row] * taper_[col]; }
   /// The 1-D taper, one value per row or column.
   const std::vector<float>& taper() const { return taper_; }
-  /// out = in * w (element-wise); in and out may be the same image.
-  void apply(const cv::Mat1f& in, cv::Mat1f& out) const;
+  /// out = (in - offset) * w (element-wise); in and out may be the same image. Subtracting the
+  /// image mean first keeps the window's own shape out of the spectrum (it would correlate at
+  /// zero shift between any two frames).
+  void apply(const cv::Mat1f& in, cv::Mat1f& out, float offset = 0.0f) const;
 
  private:
   std::vector<float> taper_;

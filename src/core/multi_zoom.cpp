@@ -64,7 +64,8 @@ MultiZoomTranslation MultiZoomTranslator::analyse(const FrameSpectra& older, con
     if (!(weight > 0.0)) continue;
     const double zoom = std::exp(-(bin - n / 2) * log_zoom_per_bin);
     result.zooms.push_back(zoom);
-    warpSimilarityWindowed(older.grey, rotation_zoom.rotation, zoom, context_->window(), warped_);
+    warpSimilarityWindowed(older.grey, rotation_zoom.rotation, zoom, context_->window(), warped_,
+                           older.mean);
     context_->fft().forward(warped_, warped_spectrum_);
     normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_);
     context_->fft().inverse(cross_power_, correlation_);

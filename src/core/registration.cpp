@@ -160,7 +160,8 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                                       RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
-  warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped_);
+  warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped_,
+                         older.mean);
   context_->fft().forward(warped_, warped_spectrum_);
 
   if (context_->config().resolve_half_turn) {

@@ -13,6 +13,9 @@
 namespace oefmt {
 namespace {
 
+// Largest |intensity| whose spectra stay accurate in single precision at any working size.
+constexpr double kMaxSpectralIntensity = 1024.0;
+
 // H = 1 - cos^2(|X|) with X sampled so that DC (N/2, N/2) is exactly 0 and the edge is pi/2.
 cv::Mat1f makeHighPass(int n) {
   cv::Mat1f filter(n / 2 + 2, n);  // the half plane the log-polar samples
@@ -119,9 +122,21 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   }
   FrameSpectra frame;
   frame.grey = image.grey.isContinuous() ? image.grey : image.grey.clone();
+  // Float frames keep their values, and single-precision spectra overflow (or the normalised
+  // cross power drops frequencies) far below FLT_MAX: scale such frames down. Every correlation
+  // is normalised, so a frame's intensity scale does not change its registration.
+  double low = 0.0, high = 0.0;
+  cv::minMaxLoc(frame.grey, &low, &high);
+  const double largest = std::max(-low, high);
+  if (largest > kMaxSpectralIntensity && std::isfinite(largest)) {
+    cv::Mat1f scaled;  // a new buffer: frame.grey may share the caller's pixels
+    frame.grey.convertTo(scaled, CV_32F, kMaxSpectralIntensity / largest);
+    frame.grey = scaled;
+  }
   frame.texture = image.texture;
   frame.invalid_pixels = image.invalid_pixels;
-  context_->window().apply(frame.grey, windowed_);
+  frame.mean = static_cast<float>(cv::mean(frame.grey)[0]);
+  context_->window().apply(frame.grey, windowed_, frame.mean);
   context_->fft().forward(windowed_, frame.spectrum);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   context_->logPolar(magnitude_, log_polar_);

@@ -10,14 +10,16 @@
 namespace oefmt {
 namespace {
 
-// Bilinear sample with neighbours outside the source counted as 0.
-inline float sampleBilinear(const float* src, int stride, int cols, int rows, float sx, float sy) {
+// Bilinear sample less `offset`, with neighbours outside the source counted as `offset` (so
+// that outside is 0 after the subtraction).
+inline float sampleBilinear(const float* src, int stride, int cols, int rows, float sx, float sy,
+                            float offset) {
   if (!(sx > -1.0f && sy > -1.0f && sx < cols && sy < rows)) return 0.0f;  // outside (or NaN)
   // floor for values > -1 without a libm call: truncate after shifting to positive.
   const int x0 = static_cast<int>(sx + 1.0f) - 1, y0 = static_cast<int>(sy + 1.0f) - 1;
   const float fx = sx - static_cast<float>(x0), fy = sy - static_cast<float>(y0);
   auto at = [&](int x, int y) -> float {
-    return (x < 0 || y < 0 || x >= cols || y >= rows) ? 0.0f : src[y * stride + x];
+    return (x < 0 || y < 0 || x >= cols || y >= rows) ? 0.0f : src[y * stride + x] - offset;
   };
   const float top = at(x0, y0) + fx * (at(x0 + 1, y0) - at(x0, y0));
   const float bottom = at(x0, y0 + 1) + fx * (at(x0 + 1, y0 + 1) - at(x0, y0 + 1));
@@ -27,7 +29,7 @@ inline float sampleBilinear(const float* src, int stride, int cols, int rows, fl
 }  // namespace
 
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
-                            const SeparableWindow& window, cv::Mat1f& out) {
+                            const SeparableWindow& window, cv::Mat1f& out, float offset) {
   if (source.empty() || source.rows != window.size() || source.cols != window.size() ||
       !(zoom > 0.0) || !source.isContinuous()) {
     throw InputError("warpSimilarityWindowed: bad source, window or zoom");
@@ -70,7 +72,7 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
         cv::v_store(sxs, sx);
         cv::v_store(sys, sy);
         for (int k = 0; k < 4; ++k) {
-          o[x + k] = row_weight * taper[x + k] * sampleBilinear(src, stride, cols, rows, sxs[k], sys[k]);
+          o[x + k] = row_weight * taper[x + k] * sampleBilinear(src, stride, cols, rows, sxs[k], sys[k], offset);
         }
         continue;
       }
@@ -80,12 +82,12 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
       const cv::v_float32x4 p10 = cv::v_lut(src + stride, index), p11 = cv::v_lut(src + stride + 1, index);
       const cv::v_float32x4 top = p00 + fx * (p01 - p00);
       const cv::v_float32x4 bottom = p10 + fx * (p11 - p10);
-      cv::v_store(o + x, (top + fy * (bottom - top)) * cv::v_load(taper + x) *
-                             cv::v_setall_f32(row_weight));
+      cv::v_store(o + x, (top + fy * (bottom - top) - cv::v_setall_f32(offset)) *
+                             cv::v_load(taper + x) * cv::v_setall_f32(row_weight));
     }
 #endif
     for (; x < cols; ++x) {
-      o[x] = row_weight * taper[x] * sampleBilinear(src, stride, cols, rows, sx0 + a00 * x, sy0 + a10 * x);
+      o[x] = row_weight * taper[x] * sampleBilinear(src, stride, cols, rows, sx0 + a00 * x, sy0 + a10 * x, offset);
     }
   }
 }

@@ -16,7 +16,7 @@ SeparableWindow::SeparableWindow(int n, double taper_fraction) : taper_(static_c
   }
 }
 
-void SeparableWindow::apply(const cv::Mat1f& in, cv::Mat1f& out) const {
+void SeparableWindow::apply(const cv::Mat1f& in, cv::Mat1f& out, float offset) const {
   if (in.rows != size() || in.cols != size()) throw InputError("window: image of the wrong size");
   out.create(in.size());
   const float* t = taper_.data();
@@ -24,7 +24,7 @@ void SeparableWindow::apply(const cv::Mat1f& in, cv::Mat1f& out) const {
     const float* src = in[r];
     float* dst = out[r];
     const float row_weight = t[r];
-    for (int c = 0; c < in.cols; ++c) dst[c] = src[c] * row_weight * t[c];
+    for (int c = 0; c < in.cols; ++c) dst[c] = (src[c] - offset) * row_weight * t[c];
   }
 }
 
