@@ -96,6 +96,8 @@ struct EstimatorConfig {
   /// Focal length in pixels of the working image (registration.size); 0 = assume size (a 53 deg
   /// field of view). Scale the camera's fx by size / min(width, height) (scaleIntrinsics).
   double fx = 0.0;
+  /// Run the two registrations of a frame (1-2 and 0-2) on two threads (the second core).
+  bool parallel_registrations = true;
   RegistrationConfig registration;
   MatchingConfig matching;
   LocalOptimizerOptions optimizer;

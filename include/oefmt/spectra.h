@@ -82,9 +82,8 @@ class SpectraBuilder {
 
  private:
   std::shared_ptr<const SpectralContext> context_;
-  cv::Mat1f windowed_;
+  cv::Mat1f windowed_;  // apodized image, then the log-polar image
   cv::Mat1f magnitude_;
-  cv::Mat1f log_polar_;
 };
 
 /// Writes rows 0 .. N/2 + 1 of the centred N x N image |spectrum| * filter (DC at (N/2, N/2)):

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <utility>
 
@@ -53,6 +54,7 @@ struct Estimator::State {
   explicit State(const EstimatorConfig& c)
       : config(c),
         registrar(c.registration),
+        registrar02(registrar.sharedContext()),
         optimizer(c.optimizer),
         integrator(c.initialAltitude(), c.effectiveFx()),
         multi_zoom(registrar.sharedContext(), c.efmt) {}
@@ -89,6 +91,8 @@ struct Estimator::State {
 
   const EstimatorConfig& config;
   Registrar registrar;
+  Registrar registrar02;  // pair 0-2, on its own thread: its own scratch, the shared tables
+  std::future<PairRegistration> pending02;  // pair 0-2 started alongside pair 1-2
   LocalOptimizer optimizer;
   PoseIntegrator integrator;
   MultiZoomTranslator multi_zoom;
@@ -198,7 +202,8 @@ PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
 
 PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) {
   Clock::time_point t = Clock::now();
-  est.registration02 = registrar.registerPair(f0->spectra, frame.spectra);
+  est.registration02 = pending02.valid() ? pending02.get()
+                                          : registrar02.registerPair(f0->spectra, frame.spectra);
   est.has_registration02 = true;
   est.registration_ms += msSince(t);
   const PairRegistration& reg12 = est.registration12;
@@ -334,9 +339,21 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                                           ? RegistrationMethod::kClassic
                                           : RegistrationMethod::kEnergyVectors;
     const Clock::time_point t = Clock::now();
+    if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 && config_.parallel_registrations) {
+      // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
+      // cached spectra; each Registrar has its own scratch). Collected in oefmtStep; discarded
+      // if pair 1-2 fails.
+      const FrameSpectra& older = s.f0->spectra;
+      const FrameSpectra& newer = frame.spectra;
+      s.pending02 = std::async(std::launch::async, [&s, &older, &newer] {
+        return s.registrar02.registerPair(older, newer);
+      });
+    }
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method);
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {
+      if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below
+      s.pending02 = {};
       s.registrationFailed(std::move(frame), textured, est);
     } else {
       est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);

@@ -127,7 +127,8 @@ std::vector<Section> sections(EstimatorConfig& c) {
                      }
                    },
                    [&c] { return std::string(toString(c.mode)); }},
-                  number("altitude", c.altitude), number("fx", c.fx)},
+                  number("altitude", c.altitude), number("fx", c.fx),
+                  boolean("parallel_registrations", c.parallel_registrations)},
                  [&c] {
                    require(std::isfinite(c.altitude) && c.altitude >= 0.0, "altitude",
                            "must be >= 0 m (0 = unknown)");

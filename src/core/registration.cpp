@@ -160,9 +160,12 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                                       RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
-  warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped_,
+  // The warped image lives in the correlation buffer: it is dead once transformed, before the
+  // correlation is written (one image of memory less per Registrar).
+  cv::Mat1f& warped = correlation_;
+  warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
                          older.mean);
-  context_->fft().forward(warped_, warped_spectrum_);
+  context_->fft().forward(warped, warped_spectrum_);
 
   if (context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi

@@ -139,8 +139,10 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   context_->window().apply(frame.grey, windowed_, frame.mean);
   context_->fft().forward(windowed_, frame.spectrum);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
-  context_->logPolar(magnitude_, log_polar_);
-  context_->fft().forward(log_polar_, frame.log_polar_spectrum);
+  // The apodized image is dead once transformed: its buffer takes the log-polar image.
+  cv::Mat1f& log_polar = windowed_;
+  context_->logPolar(magnitude_, log_polar);
+  context_->fft().forward(log_polar, frame.log_polar_spectrum);
   return frame;
 }
 

@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
     oefmt::Intrinsics intrinsics = opened->intrinsics();
     if (options.fx > 0.0) intrinsics.fx = intrinsics.fy = options.fx;
     const std::string source_text = opened->describe();
-    oefmt::PrefetchingSource source(std::move(opened));
+    // Two frames ahead keep the decoder busy while the estimator runs; more only costs memory.
+    oefmt::PrefetchingSource source(std::move(opened), 2);
 
     trajectory.open(options.output);
     if (!trajectory) throw oefmt::InputError("cannot write '" + options.output + "'");
