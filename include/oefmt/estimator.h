@@ -67,6 +67,9 @@ struct Estimate {
   double optimizer_ms = 0.0;     ///< local optimizer (part of estimator_ms)
   double estimator_ms = 0.0;     ///< everything but registration: matching, optimizer, bookkeeping
   double total_ms = 0.0;
+
+  /// Correlation surfaces of pair 1-2, only when setKeepSurfaces(true) (for debug images).
+  std::optional<RegistrationSurfaces> surfaces12;
 };
 
 /// Frames in, poses out. Keeps a window of the last two accepted frames' spectra (computed once per
@@ -103,6 +106,9 @@ class Estimator {
   /// Forgets every frame; the next frame is the new origin.
   void reset();
 
+  /// Copy pair 1-2's correlation surfaces into every Estimate (costs copies; for debug views).
+  void setKeepSurfaces(bool keep) { keep_surfaces_ = keep; }
+
   const EstimatorConfig& config() const { return config_; }
   const Pose4& pose() const;
   std::size_t frameCount() const { return frame_count_; }
@@ -116,6 +122,7 @@ class Estimator {
 
   EstimatorConfig config_;
   std::size_t frame_count_ = 0;
+  bool keep_surfaces_ = false;
   std::unique_ptr<State> state_;
 };
 

@@ -349,7 +349,9 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
         return s.registrar02.registerPair(older, newer);
       });
     }
-    est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method);
+    RegistrationSurfaces* surfaces = nullptr;
+    if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
+    est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces);
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {
       if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below

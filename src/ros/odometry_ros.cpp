@@ -321,6 +321,9 @@ void OdometryRos::process(const InputFrame& frame) {
     return;
   }
   undistortIfNeeded(image);
+  // Correlation surfaces cost copies: only while someone watches them.
+  estimator_->setKeepSurfaces(rotation_zoom_publisher_.getNumSubscribers() > 0 ||
+                              translation_publisher_.getNumSubscribers() > 0);
   const auto start = std::chrono::steady_clock::now();
   const std::optional<Estimate> estimate = estimator_->push(image, frame.stamp.toSec());
   last_processing_ms_ =
@@ -411,12 +414,23 @@ void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
 }
 
 void OdometryRos::publishDebugImages(const InputFrame& frame, const Estimate& estimate) {
-  if (energy_image_publisher_.getNumSubscribers() == 0) return;
   std_msgs::Header header;
   header.stamp = frame.stamp;
   header.frame_id = frame.frame_id;
-  const cv::Mat plot = renderEnergyVectors(estimate, estimator_->shiftPerBin());
-  energy_image_publisher_.publish(cv_bridge::CvImage(header, "bgr8", plot).toImageMsg());
+  if (energy_image_publisher_.getNumSubscribers() > 0) {
+    const cv::Mat plot = renderEnergyVectors(estimate, estimator_->shiftPerBin());
+    energy_image_publisher_.publish(cv_bridge::CvImage(header, "bgr8", plot).toImageMsg());
+  }
+  if (!estimate.surfaces12) return;
+  const RegistrationSurfaces& surfaces = *estimate.surfaces12;
+  if (rotation_zoom_publisher_.getNumSubscribers() > 0 && !surfaces.rotation_zoom.empty()) {
+    rotation_zoom_publisher_.publish(
+        cv_bridge::CvImage(header, "bgr8", renderSurface(surfaces.rotation_zoom)).toImageMsg());
+  }
+  if (translation_publisher_.getNumSubscribers() > 0 && !surfaces.translation.empty()) {
+    translation_publisher_.publish(
+        cv_bridge::CvImage(header, "bgr8", renderSurface(surfaces.translation)).toImageMsg());
+  }
 }
 
 void OdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

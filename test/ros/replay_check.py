@@ -28,6 +28,7 @@ import rostest
 import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from nav_msgs.msg import Odometry, Path
+from sensor_msgs.msg import Image
 
 from oefmt.msg import EnergyVectors
 
@@ -82,11 +83,16 @@ class ReplayCheck(unittest.TestCase):
             run([tool("oefmt_folder_to_bag"), "--quiet", cls.flight, cls.bag])
 
         cls.odometry, cls.energy, cls.diagnostics, cls.paths = [], [], [], []
+        cls.debug_images = {"rotation_zoom": [], "translation": []}
         cls.lock = threading.Lock()
         rospy.Subscriber("/odom", Odometry, lambda m: cls.store(cls.odometry, m), queue_size=200)
         rospy.Subscriber("/energy_vectors", EnergyVectors, lambda m: cls.store(cls.energy, m), queue_size=200)
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.store(cls.diagnostics, m), queue_size=50)
         rospy.Subscriber("/path", Path, lambda m: cls.store(cls.paths, m), queue_size=5)
+        rospy.Subscriber("/debug/rotation_zoom_psd", Image,
+                         lambda m: cls.store(cls.debug_images["rotation_zoom"], (m.width, m.height)), queue_size=5)
+        rospy.Subscriber("/debug/translation_psd", Image,
+                         lambda m: cls.store(cls.debug_images["translation"], (m.width, m.height)), queue_size=5)
         cls.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(600))
         cls.tf_listener = tf2_ros.TransformListener(cls.tf_buffer)
 
@@ -161,6 +167,15 @@ class ReplayCheck(unittest.TestCase):
         self.assertEqual(last.mode, "oefmt")
         self.assertTrue(paths)
         self.assertEqual(len(paths[-1].poses), self.frames)
+
+    def test_debug_surfaces_while_subscribed(self):
+        with self.lock:
+            rotation_zoom = list(self.debug_images["rotation_zoom"])
+            translation = list(self.debug_images["translation"])
+        self.assertTrue(rotation_zoom, "no debug/rotation_zoom_psd image")
+        self.assertTrue(translation, "no debug/translation_psd image")
+        self.assertEqual(rotation_zoom[-1], (512, 512))
+        self.assertEqual(translation[-1], (512, 512))
 
     def test_diagnostics_ok(self):
         with self.lock:
