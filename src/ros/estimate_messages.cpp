@@ -25,12 +25,26 @@ std::vector<float> toFloat(const std::vector<float>& v) { return v; }
 
 }  // namespace
 
-nav_msgs::Odometry odometryMessage(const Estimate& estimate, const Pose4* previous,
+Pose4 rotatedPose(const Pose4& pose, double mount_yaw) {
+  if (mount_yaw == 0.0) return pose;
+  const double c = std::cos(mount_yaw), s = std::sin(mount_yaw);
+  Pose4 out = pose;
+  out.x = c * pose.x - s * pose.y;
+  out.y = s * pose.x + c * pose.y;
+  cv::Matx44d rotation = cv::Matx44d::eye();
+  rotation(0, 0) = c;
+  rotation(0, 1) = -s;
+  rotation(1, 0) = s;
+  rotation(1, 1) = c;
+  out.covariance = rotation * pose.covariance * rotation.t();
+  return out;
+}
+
+nav_msgs::Odometry odometryMessage(const Pose4& pose, const Pose4* previous,
                                    const std_msgs::Header& header, const std::string& child_frame) {
   nav_msgs::Odometry odometry;
   odometry.header = header;
   odometry.child_frame_id = child_frame;
-  const Pose4& pose = estimate.pose;
   odometry.pose.pose.position.x = pose.x;
   odometry.pose.pose.position.y = pose.y;
   odometry.pose.pose.position.z = pose.z;

@@ -294,6 +294,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
       config.altitude = parameters_.initial_altitude;
     }
     estimator_ = std::make_unique<Estimator>(config);
+    lookUpCameraMount(frame);
     estimator_fx_ = working_fx;
     input_size_ = image.size();
     ROS_INFO_STREAM(name_ << ": odometry started at " << frame.stamp << " (" << image.cols << "x"
@@ -301,6 +302,37 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
                           << (config.altitude > 0.0 ? "metric" : "initial altitude = 1") << ")");
   }
   return true;
+}
+
+void OdometryRos::lookUpCameraMount(const InputFrame& frame) {
+  mount_yaw_ = 0.0;
+  const std::string camera_frame =
+      parameters_.camera_frame.empty() ? frame.frame_id : parameters_.camera_frame;
+  if (camera_frame.empty()) return;
+  geometry_msgs::TransformStamped mount;
+  try {
+    mount = tf_buffer_.lookupTransform(parameters_.base_frame, camera_frame, ros::Time(0),
+                                       ros::Duration(0.2));
+  } catch (const tf2::TransformException& e) {
+    ROS_INFO_STREAM(name_ << ": no TF " << parameters_.base_frame << " -> " << camera_frame
+                          << " (" << e.what() << "): " << parameters_.base_frame
+                          << " is taken to be the camera body (looking straight down, x = image "
+                             "right, y = image up)");
+    return;
+  }
+  const auto& q = mount.transform.rotation;
+  const tf2::Matrix3x3 optical(tf2::Quaternion(q.x, q.y, q.z, q.w));
+  // Camera body = optical frame with y and z flipped (x image right, y image up, z up).
+  const tf2::Matrix3x3 body = optical * tf2::Matrix3x3(1, 0, 0, 0, -1, 0, 0, 0, -1);
+  const double tilt = std::acos(std::clamp(body[2][2], -1.0, 1.0));
+  if (tilt > 10.0 * M_PI / 180.0) {
+    ROS_WARN_STREAM(name_ << ": the camera is tilted " << tilt * 180.0 / M_PI
+                          << " deg from straight down; the 4-DOF odometry assumes a level, "
+                             "down-looking camera");
+  }
+  mount_yaw_ = std::atan2(body[1][0], body[0][0]);
+  ROS_INFO_STREAM(name_ << ": camera mount from TF: yaw " << mount_yaw_ * 180.0 / M_PI
+                        << " deg in " << parameters_.base_frame);
 }
 
 void OdometryRos::process(const InputFrame& frame) {
@@ -365,28 +397,29 @@ void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
     ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": non-finite pose withheld at " << frame.stamp);
     return;
   }
+  const Pose4 pose = rotatedPose(estimate.pose, mount_yaw_);
   std_msgs::Header header;
   header.stamp = frame.stamp;
   header.frame_id = parameters_.odom_frame;
   const Pose4* previous = previous_pose_ ? &*previous_pose_ : nullptr;
-  odometry_publisher_.publish(odometryMessage(estimate, previous, header, parameters_.base_frame));
-  previous_pose_ = estimate.pose;
+  odometry_publisher_.publish(odometryMessage(pose, previous, header, parameters_.base_frame));
+  previous_pose_ = pose;
   if (parameters_.publish_tf) {
-    tf_broadcaster_.sendTransform(transformMessage(estimate.pose, header, parameters_.base_frame));
+    tf_broadcaster_.sendTransform(transformMessage(pose, header, parameters_.base_frame));
   }
   if (parameters_.path_length > 0) {
-    geometry_msgs::PoseStamped pose;
-    pose.header = header;
-    pose.pose.position.x = estimate.pose.x;
-    pose.pose.position.y = estimate.pose.y;
-    pose.pose.position.z = estimate.pose.z;
-    const auto q = yawQuaternion(estimate.pose.yaw);
-    pose.pose.orientation.x = q[0];
-    pose.pose.orientation.y = q[1];
-    pose.pose.orientation.z = q[2];
-    pose.pose.orientation.w = q[3];
+    geometry_msgs::PoseStamped stamped;
+    stamped.header = header;
+    stamped.pose.position.x = pose.x;
+    stamped.pose.position.y = pose.y;
+    stamped.pose.position.z = pose.z;
+    const auto q = yawQuaternion(pose.yaw);
+    stamped.pose.orientation.x = q[0];
+    stamped.pose.orientation.y = q[1];
+    stamped.pose.orientation.z = q[2];
+    stamped.pose.orientation.w = q[3];
     path_.header = header;
-    path_.poses.push_back(pose);
+    path_.poses.push_back(stamped);
     if (static_cast<int>(path_.poses.size()) > parameters_.path_length) {
       path_.poses.erase(path_.poses.begin(),
                         path_.poses.begin() + (path_.poses.size() - parameters_.path_length));

@@ -27,6 +27,7 @@ import rospy
 import rostest
 import tf2_ros
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry, Path
 from sensor_msgs.msg import Image
 
@@ -70,6 +71,9 @@ class ReplayCheck(unittest.TestCase):
         cls.max_ate_mean = float(rospy.get_param("~max_ate_mean", 0.05))
         cls.compare_offline = rospy.get_param("~compare_offline", True)
         cls.size = int(rospy.get_param("~size", 256))
+        # With ~mount_yaw, the camera body is mounted turned by that yaw in base_link (static
+        # TF base_link -> camera_optical): the node's odometry is the offline one turned by it.
+        cls.mount_yaw = float(rospy.get_param("~mount_yaw", 0.0))
         cls.workdir = tempfile.mkdtemp(prefix="oefmt_rostest_")
         cls.flight = os.path.join(cls.workdir, "flight")
         cls.bag = os.path.join(cls.workdir, "flight.bag")
@@ -96,6 +100,19 @@ class ReplayCheck(unittest.TestCase):
         cls.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(600))
         cls.tf_listener = tf2_ros.TransformListener(cls.tf_buffer)
 
+        if cls.mount_yaw != 0.0:
+            cls.static_tf = tf2_ros.StaticTransformBroadcaster()
+            mount = TransformStamped()
+            mount.header.stamp = rospy.Time(0)
+            mount.header.frame_id = "base_link"
+            mount.child_frame_id = "camera_optical"
+            # Rz(mount_yaw) * Rx(pi): optical z looks down, optical x = body x turned by the yaw.
+            half = cls.mount_yaw / 2.0
+            mount.transform.rotation.x = math.cos(half)
+            mount.transform.rotation.y = math.sin(half)
+            mount.transform.rotation.z = 0.0
+            mount.transform.rotation.w = 0.0
+            cls.static_tf.sendTransform(mount)
         image_topic = "/camera/image_raw/compressed" if cls.compressed else "/camera/image_raw"
         cls.wait_for_subscriber(image_topic, timeout=30.0)
         cls.wait_for_subscriber("/energy_vectors", timeout=10.0)
@@ -204,6 +221,9 @@ class ReplayCheck(unittest.TestCase):
         run([tool("oefmt_offline"), "--quiet", "--bag", self.bag, "--output", offline])
         with open(offline) as f:
             reference = [list(map(float, line.split())) for line in f if not line.startswith("#")]
+        c, s = math.cos(self.mount_yaw), math.sin(self.mount_yaw)
+        for row in reference:  # the mount turns the odom frame (see ~mount_yaw)
+            row[1], row[2] = c * row[1] - s * row[2], s * row[1] + c * row[2]
         node = self.poses()
         self.assertEqual(len(reference), len(node))
         # Equal up to float rounding: FFTW picks its algorithms by timing, per process, and the

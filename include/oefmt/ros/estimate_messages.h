@@ -14,11 +14,16 @@
 
 namespace oefmt {
 
-/// Odometry of `estimate` in header.frame_id with child_frame: pose and covariance from the
-/// estimate; the twist (in child_frame) from the difference to `previous` (none: zero twist with
-/// a large covariance). Covariances are never zero; roll and pitch are reported unobserved.
-nav_msgs::Odometry odometryMessage(const Estimate& estimate, const Pose4* previous,
+/// Odometry of `pose` in header.frame_id with child_frame: pose and covariance; the twist (in
+/// child_frame) from the difference to `previous` (none: zero twist with a large covariance).
+/// Covariances are never zero; roll and pitch are reported unobserved.
+nav_msgs::Odometry odometryMessage(const Pose4& pose, const Pose4* previous,
                                    const std_msgs::Header& header, const std::string& child_frame);
+
+/// The pose of a base frame mounted at yaw `mount_yaw` from the camera body (x = image right),
+/// in an odom frame aligned with that base at the start: position and x-y covariance turned by
+/// mount_yaw about z, yaw unchanged. The lever arm between camera and base is ignored.
+Pose4 rotatedPose(const Pose4& pose, double mount_yaw);
 
 /// TF of a pose: header.frame_id -> child_frame.
 geometry_msgs::TransformStamped transformMessage(const Pose4& pose, const std_msgs::Header& header,

@@ -87,6 +87,7 @@ class OdometryRos {
   bool prepareEstimator(const InputFrame& frame, const cv::Mat& image);
   cv::Mat decode(const InputFrame& frame);
   void undistortIfNeeded(cv::Mat& image);
+  void lookUpCameraMount(const InputFrame& frame);
   void publish(const InputFrame& frame, const Estimate& estimate);
   void publishDebugImages(const InputFrame& frame, const Estimate& estimate);
   void resetEstimator(const std::string& why);
@@ -121,6 +122,7 @@ class OdometryRos {
   StampGuard stamp_guard_;
   nav_msgs::Path path_;
   std::optional<Pose4> previous_pose_;
+  double mount_yaw_ = 0.0;  ///< yaw of the camera body (x = image right) in base_frame, from TF
   cv::Size input_size_;
   double estimator_fx_ = 0.0;
   cv::Mat undistort_map1_, undistort_map2_;
