@@ -48,7 +48,12 @@ std::string readWholeFile(const std::string& path) {
 // Reads Camera.<key> as a number; `fallback` when absent and not required.
 double readNumber(const cv::FileStorage& storage, const std::string& path, const char* key,
                   bool required, double fallback) {
-  const cv::FileNode node = storage[std::string("Camera.") + key];
+  cv::FileNode node;
+  try {
+    node = storage[std::string("Camera.") + key];
+  } catch (const cv::Exception& e) {  // OpenCV asserts when the document is not a map
+    throw DatasetError("'" + path + "' is not a map of Camera.* keys: " + e.err);
+  }
   if (node.empty() || node.isNone()) {
     if (required) throw DatasetError("'" + path + "' has no Camera." + key);
     return fallback;
@@ -84,6 +89,8 @@ CameraParameters readCameraParameters(const std::string& path) {
     storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
     throw DatasetError("cannot parse camera parameters '" + path + "': " + e.err);
+  } catch (const std::exception& e) {  // OpenCV's parser also lets std::length_error out
+    throw DatasetError("cannot parse camera parameters '" + path + "': " + e.what());
   }
   if (!storage.isOpened()) throw DatasetError("cannot parse camera parameters '" + path + "'");
   CameraParameters camera;

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -336,6 +338,16 @@ EstimatorConfig parseConfig(const cv::FileNode& root, const std::string& source)
 }
 
 EstimatorConfig loadConfig(const std::string& yaml_path) {
+  {
+    // OpenCV's YAML reader can loop forever on a NUL byte, and a file cut short by a power loss
+    // is often padded with them: refuse such a file before parsing it.
+    std::ifstream in(yaml_path, std::ios::binary);
+    if (!in) throw InputError("cannot open configuration file '" + yaml_path + "'");
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (bytes.find('\0') != std::string::npos) {
+      throw InputError("configuration file '" + yaml_path + "' is not text (it holds a NUL byte)");
+    }
+  }
   cv::FileStorage storage;
   try {
     if (!storage.open(yaml_path, cv::FileStorage::READ)) {

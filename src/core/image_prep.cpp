@@ -93,6 +93,10 @@ PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
   } else {
     cv::resize(cropped, prepared.grey, cv::Size(size, size), 0.0, 0.0,
                side > size ? cv::INTER_AREA : cv::INTER_LINEAR);
+    // Interpolating float pixels near +-FLT_MAX (sentinel values) can overflow to inf.
+    if ((depth == CV_32F || depth == CV_64F) && !std::isfinite(cv::sum(prepared.grey)[0])) {
+      replaceNonFinite(prepared.grey);
+    }
   }
   const double count = static_cast<double>(prepared.grey.total());
   const double mean = cv::sum(prepared.grey)[0] / count;
