@@ -56,6 +56,14 @@ cv::Point2d peakWidths(const cv::Mat1f& surface, const SurfacePeak& peak, bool c
           gaussianWidth(along_rows, 2 * kRadius + 1, kRadius + peak.sub_row - peak.row, kRadius, false)};
 }
 
+// The configured block radius and smoothing; the callers set what differs per surface.
+EnergyVectorOptions energyVectorOptions(const RegistrationConfig& config) {
+  EnergyVectorOptions options;
+  options.block_radius = config.block_radius;
+  options.smoothing_sigma = config.energy_smoothing_sigma;
+  return options;
+}
+
 double confidenceFrom(double psr, double floor, double good) {
   return std::clamp((psr - floor) / (good - floor), 0.0, 1.0);
 }
@@ -139,11 +147,10 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
   result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
   result.rotation_zoom_peak = peak.value;
   if (method == RegistrationMethod::kEnergyVectors) {
-    EnergyVectorOptions options;
-    options.block_radius = context_->config().block_radius;
+    // Log-zoom columns wrap (circular correlation); only rows near the peak can win.
+    EnergyVectorOptions options = energyVectorOptions(context_->config());
     options.cyclic_cols = true;
     options.row_band = kEnergyRowBand;
-    options.smoothing_sigma = context_->config().energy_smoothing_sigma;
     EnergyVector zoom_vector = extractEnergyVector(surface_, peak, options);
     result.rotation_sigma = zoom_vector.row_sigma * CV_PI / n;
     result.log_zoom_sigma = zoom_vector.col_sigma * log_zoom_per_bin;
@@ -198,11 +205,10 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
     polar_first_row_ = centre_row - band;
     context_->polarRows(surface_, polar_first_row_, 2 * band + 1, polar_);
     const SurfacePeak polar_peak = findPeak(polar_, false);
-    EnergyVectorOptions options;
-    options.block_radius = context_->config().block_radius;
+    // Radius columns do not wrap; the rho ~ 0 column is suppressed (spec 2.4 step 2).
+    EnergyVectorOptions options = energyVectorOptions(context_->config());
     options.cyclic_cols = false;
     options.suppress_low_cols = true;
-    options.smoothing_sigma = context_->config().energy_smoothing_sigma;
     EnergyVector shift_vector = extractEnergyVector(polar_, polar_peak, options);
     result.direction_sigma = shift_vector.row_sigma * 2.0 * CV_PI / n;
     result.shift_sigma = shift_vector.col_sigma * context_->polarRadiusStep();
