@@ -9,6 +9,7 @@ if(TARGET oefmt_io_tests)
   target_compile_definitions(oefmt_io_tests PRIVATE
     OEFMT_SIMULATE="$<TARGET_FILE:oefmt_simulate>"
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"
-    OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>")
-  add_dependencies(oefmt_io_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate)
+    OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>"
+    OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>")
+  add_dependencies(oefmt_io_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline)
 endif()

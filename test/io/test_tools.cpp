@@ -97,3 +97,59 @@ TEST(Tools, ExitCodesAndMessages) {
 
 }  // namespace
 }  // namespace oefmt
+
+namespace oefmt {
+namespace {
+
+// Truncates a file to `bytes` (a PNG cut short by a full disk or a copy that was interrupted).
+void truncateFile(const std::string& path, std::size_t bytes) {
+  const std::string text = readFile(path);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(text.data(), static_cast<std::streamsize>(std::min(bytes, text.size())));
+}
+
+std::size_t trajectoryLines(const std::string& path) {
+  std::ifstream in(path);
+  std::size_t lines = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] != '#') ++lines;
+  }
+  return lines;
+}
+
+// oefmt_offline on a folder whose 6th image is truncated and on a corrupt bag: a message naming
+// the file, exit status 1, and the trajectory up to the bad frame kept and valid.
+TEST(Tools, OfflineKeepsTheTrajectoryOnBadInput) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 10 --length 25 --seed 4 --bag " +
+                                    (dir / "flight.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  const ToolRun good = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                    " --output " + (dir / "good.tum"));
+  ASSERT_EQ(good.status, 0) << good.err;
+  EXPECT_EQ(trajectoryLines(dir / "good.tum"), 10u);
+
+  truncateFile(dir / "flight/Images/0006.png", 200);
+  const ToolRun bad = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                   " --output " + (dir / "bad.tum"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("0006.png"), std::string::npos) << bad.err;
+  EXPECT_EQ(trajectoryLines(dir / "bad.tum"), 5u);  // frames 0..4, each line complete
+  const ToolRun evaluate = run(dir, std::string(OEFMT_EVALUATE) + " --match index --json-only " +
+                                        (dir / "bad.tum") + " " + (dir / "flight/groundtruth.tum"));
+  EXPECT_EQ(evaluate.status, 0) << evaluate.err;  // the partial file is a valid trajectory
+
+  truncateFile(dir / "flight.bag", 5000);
+  const ToolRun corrupt = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --bag " + (dir / "flight.bag") +
+                                       " --output " + (dir / "bag.tum"));
+  EXPECT_EQ(corrupt.status, 1);
+  EXPECT_NE(corrupt.err.find("flight.bag"), std::string::npos) << corrupt.err;
+
+  const ToolRun missing = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "nowhere") +
+                                       " --output " + (dir / "none.tum"));
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("nowhere"), std::string::npos) << missing.err;
+}
+
+}  // namespace
+}  // namespace oefmt
