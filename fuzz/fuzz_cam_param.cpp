@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Arbitrary bytes as a file -> readCameraParameters (a dataset's cam_param.yaml) and loadConfig
+// (the estimator's YAML). Both must either return checked values or throw their documented
+// exception (DatasetError / InputError); anything else escaping (cv::Exception, bad_alloc, ...)
+// terminates the run and is a finding. An accepted configuration must survive a round trip
+// through configToYaml. OpenCV 4.6's YAML reader never returns on some malformed documents
+// (" e: 5\nabc-\n\n", "---e:x\nlt\n-\n"): scripts/hardening.sh runs this target in fork mode and
+// tells such timeouts (stack inside cv::FileStorage) from hangs of ours.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "fuzz_check.h"
+#include "oefmt/dataset.h"
+#include "oefmt/error.h"
+#include "oefmt/estimator_config.h"
+
+namespace {
+
+// One scratch file per process (parallel fuzzing jobs must not share it).
+std::string scratchPath(const char* suffix) {
+  const char* dir = std::getenv("TMPDIR");
+  return std::string(dir != nullptr && *dir != '\0' ? dir : "/tmp") + "/oefmt_fuzz_" +
+         std::to_string(getpid()) + suffix;
+}
+
+void writeFile(const std::string& path, const char* data, size_t size) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(data, static_cast<std::streamsize>(size));
+  oefmt_fuzz::check(static_cast<bool>(out), "scratch file written");
+}
+
+void fuzzCameraParameters(const std::string& path) {
+  using namespace oefmt_fuzz;
+  try {
+    const oefmt::CameraParameters camera = oefmt::readCameraParameters(path);
+    const oefmt::Intrinsics& k = camera.intrinsics;
+    for (double v : {k.fx, k.fy, k.cx, k.cy}) checkFinite(v, "intrinsic finite");
+    check(k.fx > 0.0 && k.fy > 0.0, "fx and fy > 0", k.fx);
+    check(k.width >= 0 && k.height >= 0, "width and height >= 0", k.width);
+    const oefmt::Distortion& d = camera.distortion;
+    for (double v : {d.k1, d.k2, d.p1, d.p2}) checkFinite(v, "distortion finite");
+  } catch (const oefmt::DatasetError&) {
+  } catch (const oefmt::InputError&) {
+  }
+}
+
+void fuzzConfig(const std::string& path, const std::string& round_trip_path) {
+  oefmt::EstimatorConfig config;
+  try {
+    config = oefmt::loadConfig(path);
+  } catch (const oefmt::InputError&) {
+    return;
+  }
+  // Accepted means valid; and the text it writes must load back to the same text.
+  config.validate();
+  const std::string text = oefmt::configToYaml(config);
+  writeFile(round_trip_path, text.data(), text.size());
+  const std::string again = oefmt::configToYaml(oefmt::loadConfig(round_trip_path));
+  oefmt_fuzz::check(again == text, "configToYaml round trip");
+}
+
+// The scratch files, removed when libFuzzer exits normally (kept after a crash).
+struct ScratchFiles {
+  const std::string input = scratchPath(".yaml");
+  const std::string round_trip = scratchPath("_round_trip.yaml");
+  ~ScratchFiles() {
+    std::remove(input.c_str());
+    std::remove(round_trip.c_str());
+  }
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static const ScratchFiles files;
+  writeFile(files.input, reinterpret_cast<const char*>(data), size);
+  fuzzCameraParameters(files.input);
+  fuzzConfig(files.input, files.round_trip);
+  return 0;
+}

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Contract checks shared by the fuzz targets: a violated check aborts, which libFuzzer records
+// as a crash together with the input that caused it.
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include <opencv2/core.hpp>
+
+namespace oefmt_fuzz {
+
+[[noreturn]] inline void fail(const char* what, double value) {
+  std::fprintf(stderr, "CONTRACT VIOLATION: %s (value %g)\n", what, value);
+  std::abort();
+}
+
+inline void check(bool ok, const char* what, double value = 0.0) {
+  if (!ok) fail(what, value);
+}
+
+inline void checkFinite(double value, const char* what) { check(std::isfinite(value), what, value); }
+
+// Every element of a float matrix (any channel count) is finite.
+inline void checkFinite(const cv::Mat& m, const char* what) {
+  if (m.empty()) return;
+  check(m.depth() == CV_32F, what, m.depth());
+  check(cv::checkRange(m), what);
+}
+
+}  // namespace oefmt_fuzz

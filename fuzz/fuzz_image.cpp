@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Arbitrary bytes as a camera image -> prepareImage and Registrar::analyse. Inputs that start
+// like a PNG or JPEG file go through cv::imdecode first (the compressed-image path); anything
+// else is read as a raw image: a header byte picks the pixel type, two more the size, and the
+// rest are the pixels (float types take the bytes as bit patterns: NaN, inf, denormals).
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include <fuzzer/FuzzedDataProvider.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fuzz_check.h"
+#include "oefmt/error.h"
+#include "oefmt/image_prep.h"
+#include "oefmt/registration.h"
+
+namespace {
+
+constexpr int kSize = 64;
+
+oefmt::Registrar& registrar() {
+  static oefmt::Registrar instance([] {
+    oefmt::RegistrationConfig config;
+    config.size = kSize;
+    config.fft_planning = oefmt::FftPlanning::kEstimate;
+    return config;
+  }());
+  return instance;
+}
+
+bool looksCompressed(const uint8_t* data, size_t size) {
+  static const uint8_t kPng[] = {0x89, 'P', 'N', 'G'};
+  static const uint8_t kJpeg[] = {0xFF, 0xD8, 0xFF};
+  return (size >= sizeof(kPng) && std::memcmp(data, kPng, sizeof(kPng)) == 0) ||
+         (size >= sizeof(kJpeg) && std::memcmp(data, kJpeg, sizeof(kJpeg)) == 0);
+}
+
+cv::Mat rawImage(FuzzedDataProvider& input) {
+  static const int kTypes[] = {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_32FC1, CV_64FC1};
+  const int type = input.PickValueInArray(kTypes);
+  const int cols = input.ConsumeIntegralInRange(1, 300);
+  const int rows = input.ConsumeIntegralInRange(1, 300);
+  cv::Mat image(rows, cols, type, cv::Scalar::all(0));
+  // The pixel bytes repeat when the input is short, so small inputs still give textured images.
+  const std::vector<uint8_t> pixels = input.ConsumeRemainingBytes<uint8_t>();
+  if (!pixels.empty()) {
+    const size_t row_bytes = image.cols * image.elemSize();
+    size_t k = 0;
+    for (int r = 0; r < rows; ++r) {
+      uint8_t* row = image.ptr<uint8_t>(r);
+      for (size_t b = 0; b < row_bytes; ++b, ++k) row[b] = pixels[k % pixels.size()];
+    }
+  }
+  return image;
+}
+
+void checkPrepared(const oefmt::PreparedImage& prepared, const cv::Mat& image) {
+  using namespace oefmt_fuzz;
+  check(prepared.grey.rows == kSize && prepared.grey.cols == kSize, "prepared size");
+  checkFinite(prepared.grey, "prepared grey finite");
+  checkFinite(prepared.texture, "prepared texture finite");
+  check(prepared.texture >= 0.0, "prepared texture >= 0", prepared.texture);
+  check(prepared.invalid_pixels >= 0 &&
+            static_cast<size_t>(prepared.invalid_pixels) <= image.total(),
+        "invalid pixel count in range", prepared.invalid_pixels);
+}
+
+void checkSpectra(const oefmt::FrameSpectra& spectra) {
+  using namespace oefmt_fuzz;
+  checkFinite(spectra.grey, "spectra grey finite");
+  checkFinite(spectra.spectrum, "spectrum finite");
+  checkFinite(spectra.log_polar_spectrum, "log-polar spectrum finite");
+  checkFinite(spectra.texture, "spectra texture finite");
+}
+
+void analyse(const cv::Mat& image) {
+  try {
+    checkPrepared(oefmt::prepareImage(image, kSize), image);
+    checkSpectra(registrar().analyse(image));
+  } catch (const oefmt::InputError&) {
+    // Documented: unsupported pixel types (e.g. a decoded 16-bit colour PNG).
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  // One thread: reproducible runs. (scripts/hardening.sh also sets OPENCV_IO_MAX_IMAGE_PIXELS,
+  // read by OpenCV at load time, so that a header claiming gigapixels is refused instead of
+  // exhausting the fuzzer's memory limit.)
+  cv::setNumThreads(0);
+  return 0;
+}
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (looksCompressed(data, size)) {
+    const cv::Mat bytes(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
+    cv::Mat decoded;
+    try {
+      decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+      return 0;  // a corrupt file is OpenCV's to refuse
+    }
+    if (!decoded.empty()) analyse(decoded);
+    return 0;
+  }
+  FuzzedDataProvider input(data, size);
+  analyse(rawImage(input));
+  return 0;
+}
