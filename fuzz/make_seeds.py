@@ -4,7 +4,8 @@
 
 FuzzedDataProvider takes integers (sizes, modes) from the END of the input and byte runs from
 the front, so each seed is laid out as: payload bytes, then the header bytes in reverse order of
-consumption. Run again after changing a target's input layout.
+consumption. Run again after changing a target's input layout. (corpus/fuzz_image/grey16x16.jpg is
+the same 16 x 16 texture as the PNG, written once by OpenCV's JPEG encoder at quality 80.)
 """
 import math
 import pathlib
