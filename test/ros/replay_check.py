@@ -89,10 +89,13 @@ class ReplayCheck(unittest.TestCase):
         cls.odometry, cls.energy, cls.diagnostics, cls.paths = [], [], [], []
         cls.debug_images = {"rotation_zoom": [], "translation": []}
         cls.lock = threading.Lock()
-        rospy.Subscriber("/odom", Odometry, lambda m: cls.store(cls.odometry, m), queue_size=200)
-        rospy.Subscriber("/energy_vectors", EnergyVectors, lambda m: cls.store(cls.energy, m), queue_size=200)
+        cls.outputs = [
+            rospy.Subscriber("/odom", Odometry, lambda m: cls.store(cls.odometry, m), queue_size=200),
+            rospy.Subscriber("/energy_vectors", EnergyVectors, lambda m: cls.store(cls.energy, m),
+                             queue_size=200),
+            rospy.Subscriber("/path", Path, lambda m: cls.store(cls.paths, m), queue_size=5),
+        ]
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.store(cls.diagnostics, m), queue_size=50)
-        rospy.Subscriber("/path", Path, lambda m: cls.store(cls.paths, m), queue_size=5)
         rospy.Subscriber("/debug/rotation_zoom_psd", Image,
                          lambda m: cls.store(cls.debug_images["rotation_zoom"], (m.width, m.height)), queue_size=5)
         rospy.Subscriber("/debug/translation_psd", Image,
@@ -115,9 +118,11 @@ class ReplayCheck(unittest.TestCase):
             cls.static_tf.sendTransform(mount)
         image_topic = "/camera/image_raw/compressed" if cls.compressed else "/camera/image_raw"
         cls.wait_for_subscriber(image_topic, timeout=30.0)
-        cls.wait_for_subscriber("/energy_vectors", timeout=10.0)
-        time.sleep(0.5)
-        run(["rosbag", "play", "--clock", "--quiet", "-r", str(cls.rate), cls.bag])
+        cls.wait_for_connections(cls.outputs, timeout=10.0)
+        # Registered at the master is not yet connected: without --wait-for-subscribers the
+        # first frames can be published before the odometry's connection is up (seen on CI).
+        run(["rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", "-r", str(cls.rate),
+             cls.bag])
         time.sleep(2.0)  # let the last frames through
 
     @classmethod
@@ -140,15 +145,35 @@ class ReplayCheck(unittest.TestCase):
             time.sleep(0.1)
         raise RuntimeError(f"nobody subscribed to {topic} within {timeout} s")
 
+    @staticmethod
+    def wait_for_connections(subscribers, timeout):
+        """Waits until each of our subscribers is connected to a publisher (not just registered)."""
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            if all(s.get_num_connections() > 0 for s in subscribers):
+                return
+            time.sleep(0.05)
+        missing = [s.name for s in subscribers if s.get_num_connections() == 0]
+        raise RuntimeError(f"no publisher connected to {missing} within {timeout} s")
+
     def poses(self):
         with self.lock:
             return [(m.header.stamp.to_sec(), m.pose.pose.position.x, m.pose.pose.position.y,
                      m.pose.pose.position.z, m.pose.pose.orientation.z, m.pose.pose.orientation.w)
                     for m in self.odometry]
 
+    def odometry_counters(self):
+        """The node's own counts from its last /diagnostics status, for failure messages."""
+        with self.lock:
+            statuses = [s for array in self.diagnostics for s in array.status if "odometry" in s.name]
+        if not statuses:
+            return "no /diagnostics status"
+        return ", ".join(f"{kv.key}: {kv.value}" for kv in statuses[-1].values)
+
     def test_every_frame_gives_odometry(self):
         stamps = [p[0] for p in self.poses()]
-        self.assertEqual(len(stamps), self.frames, "one odometry message per frame (no drop)")
+        self.assertEqual(len(stamps), self.frames,
+                         "one odometry message per frame (no drop); node: " + self.odometry_counters())
         self.assertEqual(stamps, sorted(stamps))
         self.assertEqual(len(set(stamps)), len(stamps))
 
