@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Arbitrary bytes as a camera image -> prepareImage and Registrar::analyse. Inputs that start
-// like a PNG or JPEG file go through cv::imdecode first (the compressed-image path); anything
+// like a PNG or JPEG file go through oefmt::decodeImage first (the dataset and compressed-image
+// path), and where its fast PNG decoder answers, the answer must equal cv::imdecode's; anything
 // else is read as a raw image: a header byte picks the pixel type, two more the size, and the
 // rest are the pixels (float types take the bytes as bit patterns: NaN, inf, denormals).
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include <fuzzer/FuzzedDataProvider.h>
@@ -13,6 +15,7 @@
 
 #include "fuzz_check.h"
 #include "oefmt/error.h"
+#include "oefmt/image_decoding.h"
 #include "oefmt/image_prep.h"
 #include "oefmt/registration.h"
 
@@ -96,12 +99,26 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (looksCompressed(data, size)) {
-    const cv::Mat bytes(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
     cv::Mat decoded;
     try {
-      decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception&) {
-      return 0;  // a corrupt file is OpenCV's to refuse
+      decoded = oefmt::decodeImage(data, size);
+    } catch (const oefmt::InputError&) {
+      return 0;  // documented: a header over the pixel limit
+    }
+    if (const std::optional<cv::Mat> fast = oefmt::decodePngFast(data, size)) {
+      const cv::Mat bytes(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
+      cv::Mat reference;
+      try {
+        reference = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+      } catch (const cv::Exception&) {
+      }
+      // Where both decode the bytes, the pictures must be identical.
+      if (!reference.empty()) {
+        oefmt_fuzz::check(reference.type() == fast->type() && reference.size() == fast->size(),
+                          "fast PNG decoder: type or size differs from cv::imdecode");
+        oefmt_fuzz::check(cv::norm(reference, *fast, cv::NORM_INF) == 0.0,
+                          "fast PNG decoder: pixels differ from cv::imdecode");
+      }
     }
     if (!decoded.empty()) analyse(decoded);
     return 0;

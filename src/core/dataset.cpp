@@ -9,9 +9,9 @@
 #include <fstream>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/image_decoding.h"
 
 namespace oefmt {
 namespace fs = std::filesystem;
@@ -183,7 +183,7 @@ FolderDataset::FolderDataset(const std::string& directory) : directory_(director
   readImageList();
   if (names_.empty()) throw DatasetError("dataset '" + directory_ + "' lists no image");
 
-  const cv::Mat first = cv::imread(paths_[0], cv::IMREAD_UNCHANGED);
+  const cv::Mat first = readImageFile(paths_[0]);
   if (first.empty()) {
     throw DatasetError(fs::exists(paths_[0]) ? "cannot read image '" + paths_[0] + "' (not an image?)"
                                              : "image '" + paths_[0] + "' does not exist");
@@ -276,7 +276,7 @@ double FolderDataset::timestamp(std::size_t index) const {
 
 cv::Mat FolderDataset::loadImage(std::size_t index) const {
   const std::string& path = imagePath(index);
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  cv::Mat image = readImageFile(path);
   if (image.empty()) {
     throw DatasetError(fs::exists(path) ? "cannot read image '" + path + "' (not an image or corrupt)"
                                         : "image '" + path + "' does not exist");

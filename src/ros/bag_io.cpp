@@ -13,6 +13,9 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/distortion_models.h>
 
+#include "oefmt/error.h"
+#include "oefmt/image_decoding.h"
+
 namespace oefmt {
 namespace {
 
@@ -129,9 +132,9 @@ cv::Mat imageFromMessage(const sensor_msgs::CompressedImage& message) {
   cv::Mat image;
   if (!message.data.empty()) {
     try {
-      image = cv::imdecode(message.data, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception&) {
-      image.release();
+      image = decodeImage(message.data.data(), message.data.size());
+    } catch (const InputError& e) {
+      throw BagError(std::string("compressed image: ") + e.what());
     }
   }
   if (image.empty()) {

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/image_decoding.h"
 #include "oefmt/registration.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
@@ -74,8 +75,8 @@ int main(int argc, char** argv) {
       std::printf("generated pair: rotation %.3f deg, zoom %.4f, shift (%.2f, %.2f) px\n",
                   truth.rotation * 180.0 / CV_PI, truth.zoom, truth.shift.x, truth.shift.y);
     } else {
-      older = cv::imread(paths[0], cv::IMREAD_UNCHANGED);
-      newer = cv::imread(paths[1], cv::IMREAD_UNCHANGED);
+      older = oefmt::readImageFile(paths[0]);
+      newer = oefmt::readImageFile(paths[1]);
       for (int k = 0; k < 2; ++k) {
         if ((k == 0 ? older : newer).empty()) {
           std::fprintf(stderr, "oefmt_register_pair: cannot read image '%s'\n", paths[k].c_str());
