@@ -3,6 +3,12 @@
 
 #include <fftw3.h>
 
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <mutex>
 #include <string>
 
@@ -26,7 +32,63 @@ void requireAligned(const void* data, const char* what) {
   }
 }
 
+// Measuring plans for which the wisdom had no answer takes this long at least; quicker
+// planning means the wisdom was used and there is nothing new to save.
+constexpr double kNewWisdomSeconds = 0.02;
+
+bool importWisdomLocked(const std::string& path) {
+  if (path.empty() || !std::filesystem::is_regular_file(path)) return false;
+  if (fftwf_import_wisdom_from_filename(path.c_str()) != 0) return true;
+  fftwf_forget_wisdom();  // a damaged file must not leave half its plans behind
+  return false;
+}
+
+bool exportWisdomLocked(const std::string& path) {
+  if (path.empty()) return false;
+  std::error_code error;
+  const std::filesystem::path target(path);
+  if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path(), error);
+  // Several processes may save at once: each writes its own file and renames it into place.
+  const std::string temporary = path + ".tmp" + std::to_string(::getpid());
+  if (fftwf_export_wisdom_to_filename(temporary.c_str()) == 0) {
+    std::remove(temporary.c_str());
+    return false;
+  }
+  std::filesystem::rename(temporary, target, error);
+  if (error) std::remove(temporary.c_str());
+  return !error;
+}
+
 }  // namespace
+
+std::string defaultFftWisdomPath() {
+  if (const char* explicit_path = std::getenv("OEFMT_FFTW_WISDOM")) {
+    const std::string path(explicit_path);
+    return path == "none" ? std::string() : path;
+  }
+  std::filesystem::path cache;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && xdg[0] == '/') {
+    cache = xdg;
+  } else if (const char* home = std::getenv("HOME"); home != nullptr && home[0] == '/') {
+    cache = std::filesystem::path(home) / ".cache";
+  } else {
+    return std::string();
+  }
+  // Wisdom describes one machine: keyed by host for home folders shared between machines.
+  char host[256] = {};
+  if (::gethostname(host, sizeof(host) - 1) != 0 || host[0] == '\0') std::snprintf(host, sizeof(host), "unknown");
+  return (cache / "oefmt" / (std::string("fftwf-wisdom-") + host)).string();
+}
+
+bool importFftWisdom(const std::string& path) {
+  std::lock_guard<std::mutex> lock(plannerMutex());
+  return importWisdomLocked(path);
+}
+
+bool exportFftWisdom(const std::string& path) {
+  std::lock_guard<std::mutex> lock(plannerMutex());
+  return exportWisdomLocked(path);
+}
 
 struct Fft2d::Plans {
   fftwf_plan forward = nullptr;
@@ -41,6 +103,13 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
   cv::Mat1f image(size, size);
   cv::Mat2f spectrum(size, spectrumCols());
   std::lock_guard<std::mutex> lock(plannerMutex());
+  static bool wisdom_imported = false;  // guarded by the planner mutex
+  const std::string wisdom = planning == FftPlanning::kMeasure ? defaultFftWisdomPath() : std::string();
+  if (!wisdom_imported && !wisdom.empty()) {
+    importWisdomLocked(wisdom);
+    wisdom_imported = true;
+  }
+  const auto start = std::chrono::steady_clock::now();
   plans_->forward = fftwf_plan_dft_r2c_2d(size, size, image.ptr<float>(),
                                           reinterpret_cast<fftwf_complex*>(spectrum.data), flags);
   plans_->inverse = fftwf_plan_dft_c2r_2d(size, size,
@@ -49,6 +118,8 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
   if (plans_->forward == nullptr || plans_->inverse == nullptr) {
     throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size) + "^2 FFT");
   }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
 }
 
 Fft2d::~Fft2d() {
