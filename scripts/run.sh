@@ -16,16 +16,19 @@ packages=(
   build-essential cmake pkg-config catkin ros-base-dev libroscpp-dev libnodelet-dev
   libcv-bridge-dev libimage-transport-dev libtf2-ros-dev libtf2-geometry-msgs-dev librosbag-dev
   ros-nav-msgs ros-sensor-msgs ros-geometry-msgs ros-message-generation ros-message-runtime
-  libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev
+  libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev libdeflate-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch python3-rosbag
   rosbash python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs
   python3-tf2-ros python3-numpy python3-matplotlib
 )
+# The test command also builds the sanitizer and fuzzing checks (scripts/hardening.sh).
+test_packages=(clang-14 libclang-rt-14-dev)
 
 install_dependencies() {
   [ "${OEFMT_SKIP_INSTALL:-0}" = 1 ] && return 0
-  local missing=()
-  for p in "${packages[@]}"; do
+  local missing=() wanted=("${packages[@]}")
+  [ "$command" = test ] && wanted+=("${test_packages[@]}")
+  for p in "${wanted[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
@@ -63,6 +66,9 @@ run_tests() {
   ros_environment
   rm -rf "$build/test_results"
   cmake --build "$build" --target run_tests -j1 || true  # always exits 0; judged below
+  # Unit tests under ASan+UBSan and every libFuzzer target for 20 s (separate builds in
+  # $build/hardening); their JUnit files join the others, so the summary judges them too.
+  OEFMT_RESULTS_DIR="$build/test_results/oefmt" bash "$repo/scripts/hardening.sh" "$build/hardening" 20 || true
   # Show catkin's own view of failures, then count cases (catkin double-counts gtest cases).
   catkin_test_results "$build/test_results" 2>&1 | grep -E -v "^(Skipping|Summary)" || true
   /usr/bin/python3 "$repo/scripts/test_summary.py" "$build/test_results"
