@@ -38,7 +38,7 @@ class MultiZoomTranslator {
  private:
   std::shared_ptr<const SpectralContext> context_;
   EfmtConfig config_;
-  cv::Mat1f warped_, correlation_, surface_, polar_, fused_;
+  cv::Mat1f warped_, surface_, polar_, fused_;
   cv::Mat2f warped_spectrum_, cross_power_;
 };
 

@@ -15,6 +15,12 @@ namespace oefmt {
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
                           bool half_turn = false);
 
+/// The same cross power, modulated so that its inverse FFT (Fft2d::inverse) is directly the
+/// centred surface of centredSurface(): fftshift and the 1/N^2 folded into the spectrum as
+/// (-1)^(fx + fy) / N^2, which saves a pass and a buffer per correlation.
+void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
+                       bool half_turn = false);
+
 /// Height of the phase-correlation peak computed from the lowest frequencies only (an M x M
 /// correlation with M = small.size()): a cheap test of which of two hypotheses matches.
 double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
@@ -42,7 +48,8 @@ struct SurfacePeak {
 /// Finds the largest |surface| value. The sub-pixel position comes from the ratio of the peak to
 /// its larger neighbour on each axis, exact for the Dirichlet (sinc) peak of an ideal shift and
 /// unbiased, unlike a centre of mass or a parabola. Rows always wrap; columns wrap if cyclic_cols.
-SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols);
+/// With `stats`, the sums for peakToSidelobeRatio are gathered in the same pass.
+SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats = nullptr);
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak. About 15 for unrelated textures at N = 512, hundreds for a clean registration.

@@ -91,7 +91,7 @@ class Registrar {
   SpectraBuilder builder_;
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_;
-  cv::Mat1f correlation_, surface_, small_surface_, polar_;
+  cv::Mat1f warped_, surface_, small_surface_, polar_;
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;
 };

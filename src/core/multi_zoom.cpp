@@ -67,9 +67,8 @@ MultiZoomTranslation MultiZoomTranslator::analyse(const FrameSpectra& older, con
     warpSimilarityWindowed(older.grey, rotation_zoom.rotation, zoom, context_->window(), warped_,
                            older.mean);
     context_->fft().forward(warped_, warped_spectrum_);
-    normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_);
-    context_->fft().inverse(cross_power_, correlation_);
-    centredSurface(correlation_, surface_);
+    centredCrossPower(newer.spectrum, warped_spectrum_, cross_power_);
+    context_->fft().inverse(cross_power_, surface_);
     context_->polarRows(surface_, 0, n, polar_);
     const float w = static_cast<float>(weight);
     for (int r = 0; r < n; ++r) {

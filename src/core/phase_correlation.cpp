@@ -19,16 +19,20 @@ void requireSameShape(const cv::Mat2f& a, const cv::Mat2f& b) {
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 
-// Normalised cross power of `count` interleaved complex values; the loop has no branch and
-// no call, so the compiler vectorises it.
-void crossPowerRun(const float* p, const float* q, float* out, int count, float conjugate_sign) {
+// Normalised cross power of `count` interleaved complex values, element i multiplied by
+// `factor` * (-1)^i when `alternate`; the loop has no branch and no call, so the compiler
+// vectorises it.
+void crossPowerRun(const float* p, const float* q, float* out, int count, float conjugate_sign,
+                   float factor = 1.0f, bool alternate = false) {
+  const float odd_factor = alternate ? -factor : factor;
+#pragma omp simd
   for (int i = 0; i < count; ++i) {
     const float pr = p[2 * i], pi = p[2 * i + 1];
     const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
     const float re = pr * qr + pi * qi;
     const float im = pi * qr - pr * qi;
     // + tiny keeps 0/0 out without a branch: a vanished product stays 0.
-    const float inv = 1.0f / std::sqrt(re * re + im * im + kTinyMagnitudeSquared);
+    const float inv = ((i & 1) ? odd_factor : factor) / std::sqrt(re * re + im * im + kTinyMagnitudeSquared);
     out[2 * i] = re * inv;
     out[2 * i + 1] = im * inv;
   }
@@ -56,6 +60,20 @@ void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Ma
   // older * conj -> p * conj(q); half turn: p * q (conj(conj(q))).
   crossPowerRun(newer.ptr<float>(), older.ptr<float>(), out.ptr<float>(),
                 static_cast<int>(newer.total()), half_turn ? -1.0f : 1.0f);
+}
+
+void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
+                       bool half_turn) {
+  requireSameShape(newer, older);
+  out.create(newer.size());
+  const int n = newer.rows;
+  // (-1)^(fy + fx) shifts the inverse transform by (N/2, N/2) exactly (even N); 1/N^2 undoes
+  // FFTW's unnormalised inverse. Row fy and fy - N have the same parity.
+  const float scale = 1.0f / (static_cast<float>(n) * static_cast<float>(n));
+  for (int row = 0; row < n; ++row) {
+    crossPowerRun(newer.ptr<float>(row), older.ptr<float>(row), out.ptr<float>(row), newer.cols,
+                  half_turn ? -1.0f : 1.0f, (row & 1) ? -scale : scale, true);
+  }
 }
 
 double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool half_turn,
@@ -101,11 +119,45 @@ SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface) {
   return stats;
 }
 
-SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols) {
+SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats) {
   if (surface.empty()) throw InputError("findPeak: empty surface");
   double min_value = 0.0, max_value = 0.0;
   cv::Point min_at, max_at;
-  cv::minMaxLoc(surface, &min_value, &max_value, &min_at, &max_at);
+  if (stats == nullptr) {
+    cv::minMaxLoc(surface, &min_value, &max_value, &min_at, &max_at);
+  } else {
+    // One pass for the extremes and the sums: per row vectorised reductions, and the row is
+    // searched for the position only when it holds a new extreme.
+    *stats = SurfaceStats();
+    min_value = max_value = surface(0, 0);
+    for (int r = 0; r < surface.rows; ++r) {
+      const float* row = surface[r];
+      float row_max = row[0], row_min = row[0], abs_sum = 0.0f, square_sum = 0.0f;
+#pragma omp simd reduction(max : row_max) reduction(min : row_min) reduction(+ : abs_sum, square_sum)
+      for (int c = 0; c < surface.cols; ++c) {
+        const float v = row[c];
+        row_max = std::max(row_max, v);
+        row_min = std::min(row_min, v);
+        abs_sum += std::fabs(v);
+        square_sum += v * v;
+      }
+      stats->abs_sum += abs_sum;
+      stats->square_sum += square_sum;
+      // (A NaN is never found: column 0 then, as the sums already carry the NaN.)
+      auto column_of = [&](float value) {
+        const int c = static_cast<int>(std::find(row, row + surface.cols, value) - row);
+        return c < surface.cols ? c : 0;
+      };
+      if (row_max > max_value || r == 0) {
+        max_value = row_max;
+        max_at = cv::Point(column_of(row_max), r);
+      }
+      if (row_min < min_value || r == 0) {
+        min_value = row_min;
+        min_at = cv::Point(column_of(row_min), r);
+      }
+    }
+  }
   const bool negative = -min_value > max_value;
   const cv::Point at = negative ? min_at : max_at;
   SurfacePeak peak;

@@ -134,13 +134,13 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
 double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
                                      RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
-  normalisedCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
+  centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
   // The full surface: a coarse low-resolution search for the rotation row (to invert only a
   // band of rows) picked wrong rows on simulated flights, where much of the log-polar
   // correlation's energy sits at high frequencies.
-  context_->fft().inverse(cross_power_, correlation_);
-  const SurfaceStats stats = centredSurface(correlation_, surface_);
-  const SurfacePeak peak = findPeak(surface_, true);
+  context_->fft().inverse(cross_power_, surface_);
+  SurfaceStats stats;
+  const SurfacePeak peak = findPeak(surface_, true, &stats);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
   result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
@@ -167,9 +167,7 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                                       RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
-  // The warped image lives in the correlation buffer: it is dead once transformed, before the
-  // correlation is written (one image of memory less per Registrar).
-  cv::Mat1f& warped = correlation_;
+  cv::Mat1f& warped = warped_;
   warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
                          older.mean);
   context_->fft().forward(warped, warped_spectrum_);
@@ -187,10 +185,10 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
   }
-  normalisedCrossPower(newer.spectrum, warped_spectrum_, cross_power_, result.half_turn);
-  context_->fft().inverse(cross_power_, correlation_);
-  const SurfaceStats stats = centredSurface(correlation_, surface_);
-  const SurfacePeak peak = findPeak(surface_, true);
+  centredCrossPower(newer.spectrum, warped_spectrum_, cross_power_, result.half_turn);
+  context_->fft().inverse(cross_power_, surface_);
+  SurfaceStats stats;
+  const SurfacePeak peak = findPeak(surface_, true, &stats);
   result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
   result.direction = std::atan2(result.translation.y, result.translation.x);
   result.shift = std::hypot(result.translation.x, result.translation.y);

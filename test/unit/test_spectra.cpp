@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "oefmt/fft.h"
+#include "oefmt/phase_correlation.h"
 #include "oefmt/spectra.h"
 #include "oefmt/warp.h"
 #include "support/fixtures.h"
@@ -51,6 +52,52 @@ TEST(Fft, InverseOfForwardReturnsTheImageTimesNSquared) {
   EXPECT_EQ(spectrum.cols, 33);
   fft.inverse(spectrum, back);
   EXPECT_LT(cv::norm(back / (64.0f * 64.0f), image, cv::NORM_INF), 1e-5);
+}
+
+// The fftshift folded into the spectrum must give exactly the shifted, scaled surface, and the
+// one-pass peak search the same peak and sums as the separate passes.
+TEST(PhaseCorrelation, CentredCrossPowerEqualsShiftingTheSurface) {
+  for (const bool half_turn : {false, true}) {
+    const int n = 64;
+    const Fft2d fft(n, FftPlanning::kEstimate);
+    cv::Mat1f a(n, n), b(n, n);
+    cv::randu(a, 0.0f, 1.0f);
+    cv::randu(b, 0.0f, 1.0f);
+    cv::Mat2f fa, fb, cross, centred_cross;
+    fft.forward(a, fa);
+    fft.forward(b, fb);
+    normalisedCrossPower(fa, fb, cross, half_turn);
+    cv::Mat1f correlation, shifted, direct;
+    fft.inverse(cross, correlation);
+    const SurfaceStats expected_stats = centredSurface(correlation, shifted);
+    centredCrossPower(fa, fb, centred_cross, half_turn);
+    fft.inverse(centred_cross, direct);
+    EXPECT_LT(cv::norm(direct, shifted, cv::NORM_INF), 1e-6);
+
+    SurfaceStats stats;
+    const SurfacePeak with_stats = findPeak(direct, true, &stats);
+    const SurfacePeak plain = findPeak(shifted, true);
+    EXPECT_EQ(with_stats.row, plain.row);
+    EXPECT_EQ(with_stats.col, plain.col);
+    EXPECT_NEAR(stats.abs_sum, expected_stats.abs_sum, 1e-4 * expected_stats.abs_sum);
+    EXPECT_NEAR(stats.square_sum, expected_stats.square_sum, 1e-4 * expected_stats.square_sum);
+  }
+}
+
+TEST(PhaseCorrelation, OnePassPeakFindsNegativePeaksAndTheFirstOfTies) {
+  cv::Mat1f surface = cv::Mat1f::zeros(8, 8);
+  surface(2, 3) = 0.5f;
+  surface(5, 1) = -0.9f;
+  SurfaceStats stats;
+  SurfacePeak peak = findPeak(surface, true, &stats);
+  EXPECT_EQ(peak.row, 5);
+  EXPECT_EQ(peak.col, 1);
+  EXPECT_FLOAT_EQ(peak.value, 0.9f);
+  EXPECT_NEAR(stats.abs_sum, 1.4, 1e-6);
+  surface(5, 1) = 0.5f;  // a tie: row-major first, as cv::minMaxLoc
+  peak = findPeak(surface, true, &stats);
+  EXPECT_EQ(peak.row, 2);
+  EXPECT_EQ(peak.col, 3);
 }
 
 TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheCentre) {
