@@ -6,30 +6,24 @@
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "oefmt/error.h"
+#include "bilinear_sample.h"
+#include "warp_kernels.h"
 
 namespace oefmt {
-namespace {
+namespace detail {
 
-// Bilinear sample less `offset`, with neighbours outside the source counted as `offset` (so
-// that outside is 0 after the subtraction).
-inline float sampleBilinear(const float* src, int stride, int cols, int rows, float sx, float sy,
-                            float offset) {
-  if (!(sx > -1.0f && sy > -1.0f && sx < cols && sy < rows)) return 0.0f;  // outside (or NaN)
-  // floor for values > -1 without a libm call: truncate after shifting to positive.
-  const int x0 = static_cast<int>(sx + 1.0f) - 1, y0 = static_cast<int>(sy + 1.0f) - 1;
-  const float fx = sx - static_cast<float>(x0), fy = sy - static_cast<float>(y0);
-  auto at = [&](int x, int y) -> float {
-    return (x < 0 || y < 0 || x >= cols || y >= rows) ? 0.0f : src[y * stride + x] - offset;
-  };
-  const float top = at(x0, y0) + fx * (at(x0 + 1, y0) - at(x0, y0));
-  const float bottom = at(x0, y0 + 1) + fx * (at(x0 + 1, y0 + 1) - at(x0, y0 + 1));
-  return top + fy * (bottom - top);
+bool cpuHasAvx2Fma() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
 }
 
-}  // namespace
+}  // namespace detail
+
+using detail::sampleBilinear;
 
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
-                            const SeparableWindow& window, cv::Mat1f& out, float offset) {
+                            const SeparableWindow& window, cv::Mat1f& out, float offset,
+                            WarpKernel kernel) {
   if (source.empty() || source.rows != window.size() || source.cols != window.size() ||
       !(zoom > 0.0) || !source.isContinuous()) {
     throw InputError("warpSimilarityWindowed: bad source, window or zoom");
@@ -44,6 +38,7 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
   const float a10 = static_cast<float>(s), a11 = static_cast<float>(c);
   const int stride = static_cast<int>(source.step1());
   const float* src = source.ptr<float>();
+  const bool avx2 = kernel == WarpKernel::kAuto && detail::cpuHasAvx2Fma();
   for (int y = 0; y < rows; ++y) {
     const double dy = y - cy;
     // Source point of output (0, y); column x adds x * (a00, a10).
@@ -53,6 +48,10 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
     const float row_weight = window.taper()[y];
     const float* taper = window.taper().data();
     float* o = out[y];
+    if (avx2) {
+      detail::warpRowAvx2({src, stride, cols, rows, sx0, sy0, a00, a10, row_weight, taper, offset, o});
+      continue;
+    }
     int x = 0;
 #if CV_SIMD128
     // Four pixels at a time where the whole 2 x 2 neighbourhood is inside the source.

@@ -168,15 +168,17 @@ void BM_Stage_HalfTurnTest(benchmark::State& state) {
 }
 BENCHMARK(BM_Stage_HalfTurnTest)->Unit(benchmark::kMicrosecond);
 
+// Argument 0: the kernel the CPU check picks (AVX2 + FMA here); 1: the portable SSE kernel.
 void BM_Stage_WarpOlder(benchmark::State& state) {
+  const auto kernel = state.range(0) == 0 ? oefmt::WarpKernel::kAuto : oefmt::WarpKernel::kPortable;
   cv::Mat1f warped;
   for (auto _ : state) {
     oefmt::warpSimilarityWindowed(inputs().older.grey, 0.05, 1.03, inputs().context->window(),
-                                  warped);
+                                  warped, 0.0f, kernel);
     benchmark::ClobberMemory();
   }
 }
-BENCHMARK(BM_Stage_WarpOlder)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_WarpOlder)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_Stage_PolarUnwrapBand(benchmark::State& state) {
   cv::Mat1f polar;

@@ -100,6 +100,27 @@ TEST(PhaseCorrelation, OnePassPeakFindsNegativePeaksAndTheFirstOfTies) {
   EXPECT_EQ(peak.col, 3);
 }
 
+// The CPU-specific kernel (AVX2 + FMA where the CPU has it) and the portable one agree up to
+// float rounding, including the border blocks that fall back to scalar samples. (On a CPU
+// without AVX2 both are the portable kernel and the test checks nothing more.)
+TEST(Warp, FastKernelMatchesThePortableOne) {
+  const int n = 128;
+  const SeparableWindow window(n, 0.1);
+  cv::Mat1f source(n, n);
+  cv::randu(source, 0.0f, 255.0f);
+  for (const double rotation : {0.0, 0.3, -2.0, 3.1}) {
+    for (const double zoom : {1.0, 0.8, 1.3}) {
+      cv::Mat1f fast, portable;
+      warpSimilarityWindowed(source, rotation, zoom, window, fast, 100.0f, WarpKernel::kAuto);
+      warpSimilarityWindowed(source, rotation, zoom, window, portable, 100.0f, WarpKernel::kPortable);
+      // FMA rounds the sample position once instead of twice: ~1e-5 px, times the up to
+      // 255-per-pixel slopes of this noise texture.
+      EXPECT_LT(cv::norm(fast, portable, cv::NORM_INF), 1e-2) << rotation << " " << zoom;
+      EXPECT_GT(cv::norm(portable, cv::NORM_INF), 10.0);
+    }
+  }
+}
+
 TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheCentre) {
   const SeparableWindow flat(64, 0.0);  // no taper: compare raw pixels
   cv::Mat1f image(64, 64, 0.0f), turned;
