@@ -32,9 +32,15 @@ struct PreparedImage {
 /// Throws InputError for an empty image or an unsupported pixel type (the message names it).
 cv::Mat1f toGreyFloat(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr);
 
-/// Centre-crops grey to a min(W, H) square and resizes it to size x size (area interpolation when
-/// shrinking, bilinear when growing). Non-finite pixels are replaced and counted.
-/// Throws InputError when size is odd or < 64, or the image is empty.
+/// Smallest centre square (min(W, H)) an input image may have: smaller frames hold too little
+/// detail to register and are refused rather than blown up to the working size.
+constexpr int kMinImageSide = 64;
+
+/// Centre-crops the image to a min(W, H) square, converts it to grey float (toGreyFloat) and
+/// resizes it to size x size (area interpolation when shrinking, bilinear when growing).
+/// Non-finite pixels are replaced and counted.
+/// Throws InputError when size is odd or < 64, the image is empty, its square is under
+/// kMinImageSide or its pixel type is unsupported.
 PreparedImage prepareImage(const cv::Mat& image, int size,
                            ChannelOrder order = ChannelOrder::kBgr);
 

@@ -78,11 +78,19 @@ PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
   if (size < 64 || size % 2 != 0) {
     throw InputError("working size must be even and >= 64, got " + std::to_string(size));
   }
-  cv::Mat1f grey = toGreyFloat(image, order);
-  const int side = std::min(grey.cols, grey.rows);
-  const cv::Rect square((grey.cols - side) / 2, (grey.rows - side) / 2, side, side);
+  if (image.empty()) throw InputError("image is empty");
+  const int side = std::min(image.cols, image.rows);
+  if (side < kMinImageSide) {
+    throw InputError("image of " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                     " pixels: its centre square must be at least " + std::to_string(kMinImageSide) +
+                     " px (too little detail to register)");
+  }
+  // Crop first (a view), then convert: a 4056 x 3040 frame converts only its centre square.
+  const cv::Rect square((image.cols - side) / 2, (image.rows - side) / 2, side, side);
+  const bool already_square = image.cols == image.rows;
+  cv::Mat1f cropped = toGreyFloat(already_square ? image : image(square), order);
+  if (!cropped.isContinuous()) cropped = cropped.clone();
   PreparedImage prepared;
-  cv::Mat1f cropped = side == grey.cols && side == grey.rows ? grey : grey(square).clone();
   // Only float inputs can hold NaN/inf; a finite sum (vectorised) proves there are none.
   const int depth = image.depth();
   if ((depth == CV_32F || depth == CV_64F) && !std::isfinite(cv::sum(cropped)[0])) {

@@ -17,6 +17,7 @@
 
 #include "oefmt/EnergyVectors.h"
 #include "oefmt/error.h"
+#include "oefmt/image_prep.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/ros/estimate_messages.h"
 #include "oefmt/ros/parameter_yaml.h"
@@ -243,6 +244,11 @@ cv::Mat OdometryRos::decode(const InputFrame& frame) {
 }
 
 bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image) {
+  // Refused before it could restart the odometry (the core would refuse it too).
+  if (std::min(image.cols, image.rows) < kMinImageSide) {
+    throw InputError("image of " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                     " pixels: under the " + std::to_string(kMinImageSide) + " px minimum");
+  }
   if (!input_size_.empty() && image.size() != input_size_) {
     resetEstimator("the image size changed from " + std::to_string(input_size_.width) + "x" +
                    std::to_string(input_size_.height) + " to " + std::to_string(image.cols) +
@@ -263,6 +269,13 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
   double fx = parameters_.camera_fx;
   if (info && info->K[0] > 0.0 && info->K[4] > 0.0) {
     fx = info->K[0];
+    if (info->width > 0 && info->height > 0 &&
+        (static_cast<int>(info->width) != image.cols || static_cast<int>(info->height) != image.rows)) {
+      ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": camera_info is for " << info->width << "x"
+                                                  << info->height << " images, the image is "
+                                                  << image.cols << "x" << image.rows
+                                                  << ": its focal length is used as it is");
+    }
   }
   // Working-image focal length: the core crops to a square and resizes to N. Without camera
   // intrinsics, the YAML's own (working-image) fx is the last resort.

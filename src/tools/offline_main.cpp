@@ -193,7 +193,12 @@ int main(int argc, char** argv) {
         estimator = std::make_unique<oefmt::Estimator>(config);
         first_stamp = frame.stamp;
       }
-      const std::optional<oefmt::Estimate> estimate = estimator->push(frame.image, frame.stamp);
+      std::optional<oefmt::Estimate> estimate;
+      try {
+        estimate = estimator->push(frame.image, frame.stamp);
+      } catch (const oefmt::InputError& e) {
+        throw oefmt::InputError(frame.name + ": " + e.what());  // which frame, for the user
+      }
       ++frames;
       if (!estimate) {
         ++not_tracked;

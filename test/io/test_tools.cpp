@@ -9,6 +9,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "io/temp_dir.h"
 #include "oefmt/dataset.h"
 #include "oefmt/ros/bag_io.h"
@@ -149,6 +151,23 @@ TEST(Tools, OfflineKeepsTheTrajectoryOnBadInput) {
                                        " --output " + (dir / "none.tum"));
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("nowhere"), std::string::npos) << missing.err;
+}
+
+// A folder of tiny (40 x 30) frames: a clear message with the size, exit status 1.
+TEST(Tools, OfflineRefusesTinyFrames) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
+                                    (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  for (const char* name : {"0001.png", "0002.png", "0003.png"}) {
+    const std::string path = dir / (std::string("flight/Images/") + name);
+    ASSERT_TRUE(std::ifstream(path).good()) << path;
+    ASSERT_TRUE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(90))));
+  }
+  const ToolRun tiny = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                    " --output " + (dir / "tiny.tum"));
+  EXPECT_EQ(tiny.status, 1);
+  EXPECT_NE(tiny.err.find("0001.png: image of 40x30"), std::string::npos) << tiny.err;
 }
 
 }  // namespace

@@ -5,7 +5,8 @@ survives, never publishes a non-finite value or a zero variance, rejects what it
 counts it in /diagnostics), and tracks again when good frames return.
 
 Bad input: an unsupported encoding, black and NaN frames, a duplicate and an out-of-order stamp,
-a change of image size, a corrupt compressed-looking payload in a raw message (wrong step).
+a change of image size, a corrupt compressed-looking payload in a raw message (wrong step), a
+tiny frame (40 x 30: refused) and a full-resolution 4056 x 3040 camera frame (a restart).
 """
 import math
 import sys
@@ -104,6 +105,12 @@ class BadInputCheck(unittest.TestCase):
         cls.send(np.zeros((256, 256), np.uint8), "mono8", stamp=cls.stamp - 0.1)    # reordered
         cls.stamp += 0.2
         cls.send(np.zeros((256, 256), np.uint8), "mono8", step=100)     # inconsistent step
+        cls.stamp += 0.2
+        cls.send(np.full((30, 40), 128, np.uint8), "mono8")             # tiny: refused
+        cls.stamp += 0.2
+        big = np.ascontiguousarray(np.kron(cls.scene[:304, :406], np.ones((10, 10), np.uint8))[:3040, :4056])
+        cls.send(big, "mono8")                                          # 4056 x 3040: restart
+        time.sleep(1.0)  # a 12 MB frame: give it time before the next
         for _ in range(4):                                              # texture returns
             cls.good(k)
             k += 1
@@ -135,8 +142,8 @@ class BadInputCheck(unittest.TestCase):
             statuses = [s for a in self.diagnostics for s in a.status if "odometry" in s.name]
         self.assertTrue(statuses)
         values = {kv.key: kv.value for kv in statuses[-1].values}
-        # unsupported encoding, duplicate, reordered, wrong step
-        self.assertGreaterEqual(int(values["frames rejected (stamp, encoding, intrinsics)"]), 4, values)
+        # unsupported encoding, duplicate, reordered, wrong step, tiny
+        self.assertGreaterEqual(int(values["frames rejected (stamp, encoding, intrinsics)"]), 5, values)
 
 
 if __name__ == "__main__":

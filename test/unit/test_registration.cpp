@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
 #include "oefmt/registration.h"
@@ -256,6 +259,44 @@ TEST(Registration, BadInputIsAClearError) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("CV_8S"), std::string::npos) << e.what();
   }
+}
+
+TEST(Registration, TinyFramesAreRefusedWithTheirSize) {
+  Registrar registrar(test::sharedContext(kN));
+  for (const cv::Size size : {cv::Size(40, 30), cv::Size(63, 200), cv::Size(1, 1)}) {
+    try {
+      registrar.analyse(cv::Mat(size, CV_8UC1, cv::Scalar(7)));
+      FAIL() << size << " was accepted";
+    } catch (const InputError& e) {
+      const std::string text = std::to_string(size.width) + "x" + std::to_string(size.height);
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(registrar.analyse(cv::Mat(64, 100, CV_8UC1, cv::Scalar(7))));
+}
+
+// A full-resolution 4056 x 3040 colour frame (the authors' camera) registers like its
+// resized centre square: the crop happens before any conversion.
+TEST(Registration, FullResolutionCameraFramesRegister) {
+  const int n = 128;
+  cv::Mat1f crop;
+  cv::normalize(test::sceneTexture(11)(cv::Rect(0, 0, 400, 300)), crop, 0.0, 255.0, cv::NORM_MINMAX);
+  cv::Mat big_grey, big8;
+  cv::resize(crop, big_grey, cv::Size(4056, 3040), 0, 0, cv::INTER_CUBIC);
+  big_grey.convertTo(big8, CV_8U);
+  cv::Mat older, newer;
+  cv::cvtColor(big8, older, cv::COLOR_GRAY2BGR);
+  // The newer frame: the scene moved 47 px right (about 2 px at 128 / 3040 scale).
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 47, 0, 1, 0);
+  cv::warpAffine(older, newer, shift, older.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  Registrar registrar(test::sharedContext(n));
+  const FrameSpectra a = registrar.analyse(older);
+  const FrameSpectra b = registrar.analyse(newer);
+  const PairRegistration r = registrar.registerPair(a, b);
+  EXPECT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(r.translation.x, 47.0 * n / 3040.0, 0.2);
+  EXPECT_NEAR(r.translation.y, 0.0, 0.2);
+  EXPECT_NEAR(r.zoom, 1.0, 0.002);
 }
 
 TEST(Registration, SmallSizesWork) {
