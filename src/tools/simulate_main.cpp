@@ -3,6 +3,7 @@
 // writes it in the authors' dataset layout with ground truth (and optionally as a ROS bag).
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -292,6 +293,15 @@ int main(int argc, char** argv) {
   try {
     const oefmt::sim::FlightPlan plan = oefmt::sim::planFlight(command.flight);
     if (!command.quiet) printPlan(plan, command);
+    // Even when quiet: a flight whose frames barely overlap (a steep climb from a low start,
+    // too few frames) cannot be followed by any frame-to-frame odometry.
+    constexpr double kLowOverlap = 0.3;
+    if (plan.top_overlap.min < kLowOverlap) {
+      std::fprintf(stderr,
+                   "oefmt_simulate: warning: consecutive frames overlap only %.0f %% at worst (on the "
+                   "highest level): raise --altitude or --frames, or lower --climb\n",
+                   std::max(0.0, plan.top_overlap.min * 100));
+    }
     oefmt::sim::FolderFlightWriter folder(command.output, plan.camera, static_cast<int>(plan.poses.size()),
                                           oefmt::sim::groundTruthHeader(plan));
     std::unique_ptr<oefmt::BagFlightWriter> bag;
