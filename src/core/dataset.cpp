@@ -12,6 +12,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/image_decoding.h"
+#include "oefmt/yaml_text.h"
 
 namespace oefmt {
 namespace fs = std::filesystem;
@@ -81,6 +82,11 @@ std::string sizeText(cv::Size size) {
 
 CameraParameters readCameraParameters(const std::string& path) {
   std::string text = readWholeFile(path);
+  try {
+    checkYamlText(text, "camera parameters '" + path + "'");
+  } catch (const InputError& e) {
+    throw DatasetError(e.what());
+  }
   // OpenCV's parser wants the %YAML directive and a final newline; users' files may lack both.
   if (text.rfind("%YAML", 0) != 0) text = "%YAML:1.0\n" + text;
   text += "\n";

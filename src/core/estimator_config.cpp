@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "oefmt/error.h"
+#include "oefmt/yaml_text.h"
 
 namespace oefmt {
 namespace {
@@ -339,14 +340,11 @@ EstimatorConfig parseConfig(const cv::FileNode& root, const std::string& source)
 
 EstimatorConfig loadConfig(const std::string& yaml_path) {
   {
-    // OpenCV's YAML reader can loop forever on a NUL byte, and a file cut short by a power loss
-    // is often padded with them: refuse such a file before parsing it.
+    // What OpenCV's YAML reader would hang or crash on is refused before it parses the file.
     std::ifstream in(yaml_path, std::ios::binary);
     if (!in) throw InputError("cannot open configuration file '" + yaml_path + "'");
     const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    if (bytes.find('\0') != std::string::npos) {
-      throw InputError("configuration file '" + yaml_path + "' is not text (it holds a NUL byte)");
-    }
+    checkYamlText(bytes, "configuration file '" + yaml_path + "'");
   }
   cv::FileStorage storage;
   try {

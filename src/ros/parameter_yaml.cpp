@@ -9,6 +9,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "oefmt/error.h"
+#include "oefmt/yaml_text.h"
 
 namespace oefmt {
 namespace {
@@ -64,6 +65,7 @@ std::string estimatorYamlFromParameters(const ros::NodeHandle& nh) {
 }
 
 EstimatorConfig parseConfigText(const std::string& yaml, const std::string& source) {
+  checkYamlText(yaml, source);
   cv::FileStorage storage;
   try {
     storage.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);

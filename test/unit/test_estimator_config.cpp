@@ -2,6 +2,7 @@
 // EstimatorConfig: YAML loading, validation and config/default.yaml.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -10,6 +11,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/estimator_config.h"
+#include "oefmt/yaml_text.h"
 
 namespace oefmt {
 namespace {
@@ -130,6 +132,49 @@ TEST(EstimatorConfig, ScaleHelpers) {
   EXPECT_EQ(parseEstimatorMode("efmt"), EstimatorMode::kEfmt);
   EXPECT_STREQ(toString(EstimatorMode::kOefmt), "oefmt");
   EXPECT_THROW(parseEstimatorMode("OEFMT"), InputError);
+}
+
+}  // namespace
+}  // namespace oefmt
+
+namespace oefmt {
+namespace {
+
+// What OpenCV's YAML reader would hang or overflow its stack on is refused before parsing.
+TEST(YamlText, DeepNestingHugeFilesAndNulBytesAreRefused) {
+  EXPECT_NO_THROW(checkYamlText("%YAML:1.0\nmode: oefmt\nregistration:\n  size: 512\n", "f"));
+  EXPECT_NO_THROW(checkYamlText("a: [1, [2, 3], {b: 4}]  # [[[[ in a comment\nc: \"[[[[\"\n", "f"));
+  const auto message = [](const std::string& text) {
+    try {
+      checkYamlText(text, "file 'x.yaml'");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("a: " + std::string(100000, '[')).find("nests"), std::string::npos);
+  EXPECT_NE(message("a: " + std::string(100, '{')).find("line 1"), std::string::npos);
+  std::string indented = "a:\n";
+  for (int level = 1; level <= 70; ++level) indented += std::string(level, ' ') + "k:\n";
+  EXPECT_NE(message(indented).find("nests"), std::string::npos);
+  std::string dashes;
+  for (int i = 0; i < 40; ++i) dashes += "- ";
+  EXPECT_NE(message(dashes + "x\n").find("nests"), std::string::npos);
+  EXPECT_NE(message(std::string("a: 1\n") + '\0').find("NUL"), std::string::npos);
+  EXPECT_NE(message(std::string(kMaxYamlBytes + 1, '#')).find("bytes"), std::string::npos);
+  EXPECT_NE(message("a: [").find("accepted"), std::string::npos) << "OpenCV's to refuse";
+}
+
+TEST(YamlText, LoadConfigRefusesADeeplyNestedFileWithoutParsingIt) {
+  const std::string path = ::testing::TempDir() + "/oefmt_deep.yaml";
+  std::ofstream(path) << "%YAML:1.0\nmode: " << std::string(200000, '[') << "\n";
+  try {
+    loadConfig(path);
+    FAIL() << "a 200000-deep file was parsed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("oefmt_deep.yaml"), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
 }
 
 }  // namespace
