@@ -198,9 +198,11 @@ void BM_Stage_PeakAndEnergyVector(benchmark::State& state) {
   oefmt::EnergyVectorOptions options;
   options.row_band = 12;  // as the registration does
   for (auto _ : state) {
-    const oefmt::SurfacePeak peak = oefmt::findPeak(surfaces.rotation_zoom, true);
+    // As the registration does: peak and PSR sums in one pass, then the energy vector.
+    oefmt::SurfaceStats stats;
+    const oefmt::SurfacePeak peak = oefmt::findPeak(surfaces.rotation_zoom, true, &stats);
     benchmark::DoNotOptimize(oefmt::extractEnergyVector(surfaces.rotation_zoom, peak, options));
-    benchmark::DoNotOptimize(oefmt::peakToSidelobeRatio(surfaces.rotation_zoom, peak));
+    benchmark::DoNotOptimize(oefmt::peakToSidelobeRatio(surfaces.rotation_zoom, peak, stats));
   }
 }
 BENCHMARK(BM_Stage_PeakAndEnergyVector)->Unit(benchmark::kMicrosecond);
