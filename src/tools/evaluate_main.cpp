@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "oefmt/dataset.h"
+#include "command_line.h"
 #include "oefmt/error.h"
 #include "oefmt/evaluation.h"
 
@@ -46,16 +47,11 @@ options:
 exit codes: 0 success, 1 unreadable input or too few matches, 2 invalid option, 3 plot failed)";
 
 std::vector<double> fractionList(const std::string& text) {
-  std::vector<double> values;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !(v > 0.0 && v <= 1.0)) {
+  const std::vector<double> values = oefmt::tools::numberList("--segments", text);
+  for (const double v : values) {
+    if (!(v > 0.0 && v <= 1.0)) {
       throw oefmt::InputError("--segments needs fractions in (0, 1] separated by commas, got '" + text + "'");
     }
-    values.push_back(v);
   }
   return values;
 }
@@ -104,12 +100,10 @@ int main(int argc, char** argv) {
   bool json_only = false;
   std::vector<std::string> paths;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      const auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw oefmt::InputError("option " + arg + " needs a value");
-        return argv[++i];
-      };
+    oefmt::tools::Arguments args(argc, argv);
+    while (!args.done()) {
+      const std::string arg = args.take();
+      const auto value = [&]() { return args.value(arg); };
       if (arg == "-h" || arg == "--help") {
         std::puts(kUsage);
         return 0;
@@ -118,12 +112,8 @@ int main(int argc, char** argv) {
         if (mode != "time" && mode != "index") throw oefmt::InputError("--match must be time or index");
         options.association = mode == "time" ? oefmt::AssociationMode::kTimestamp : oefmt::AssociationMode::kIndex;
       } else if (arg == "--tolerance") {
-        const std::string text = value();
-        char* end = nullptr;
-        options.time_tolerance = std::strtod(text.c_str(), &end);
-        if (end == text.c_str() || *end != '\0' || !(options.time_tolerance >= 0.0)) {
-          throw oefmt::InputError("--tolerance needs a number of seconds >= 0");
-        }
+        options.time_tolerance = args.number(arg);
+        if (!(options.time_tolerance >= 0.0)) throw oefmt::InputError("--tolerance needs a number of seconds >= 0");
       } else if (arg == "--3d") {
         options.planar = false;
       } else if (arg == "--no-scale") {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "oefmt/dataset.h"
+#include "command_line.h"
 #include "oefmt/error.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/sim/progress.h"
@@ -35,14 +36,6 @@ options:
   -h, --help
 exit codes: 0 success, 1 read/write failure, 2 invalid option)";
 
-double toNumber(const std::string& option, const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) {
-    throw oefmt::InputError("option " + option + " needs a number, got '" + text + "'");
-  }
-  return v;
-}
 
 }  // namespace
 
@@ -52,12 +45,10 @@ int main(int argc, char** argv) {
   std::string format = "raw";
   std::vector<std::string> paths;
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      const auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw oefmt::InputError("option " + arg + " needs a value");
-        return argv[++i];
-      };
+    oefmt::tools::Arguments args(argc, argv);
+    while (!args.done()) {
+      const std::string arg = args.take();
+      const auto value = [&]() { return args.value(arg); };
       if (arg == "-h" || arg == "--help") {
         std::puts(kUsage);
         return 0;
@@ -74,9 +65,9 @@ int main(int argc, char** argv) {
       } else if (arg == "--compression") {
         options.writer.compression = value();
       } else if (arg == "--rate") {
-        options.rate = toNumber(arg, value());
+        options.rate = args.number(arg);
       } else if (arg == "--start-time") {
-        options.start_time = toNumber(arg, value());
+        options.start_time = args.number(arg);
       } else if (arg == "--quiet") {
         quiet = true;
       } else if (!arg.empty() && arg[0] == '-') {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "frame_source.h"
 #include "oefmt/error.h"
 #include "oefmt/estimator.h"
@@ -64,39 +65,32 @@ struct Options {
   std::exit(2);
 }
 
-double parseNumber(const std::string& option, const char* text) {
-  char* end = nullptr;
-  const double value = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !std::isfinite(value)) {
-    usageError(option + " needs a number, got '" + text + "'");
-  }
-  return value;
-}
-
 Options parseArguments(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) usageError(arg + " needs a value");
-      return argv[++i];
-    };
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (arg == "--images") o.images = value();
-    else if (arg == "--bag") o.bag = value();
-    else if (arg == "--image-topic") o.image_topic = value();
-    else if (arg == "--camera-info-topic") o.camera_info_topic = value();
-    else if (arg == "--output") o.output = value();
-    else if (arg == "--diagnostics") o.diagnostics = value();
-    else if (arg == "--config") o.config = value();
-    else if (arg == "--mode") o.mode = value();
-    else if (arg == "--altitude") o.altitude = parseNumber(arg, value());
-    else if (arg == "--fx") o.fx = parseNumber(arg, value());
-    else if (arg == "--max-frames") o.max_frames = static_cast<long>(parseNumber(arg, value()));
-    else if (arg == "--quiet") o.quiet = true;
-    else usageError("unknown option '" + arg + "'");
+  oefmt::tools::Arguments args(argc, argv);
+  try {
+    while (!args.done()) {
+      const std::string arg = args.take();
+      const auto value = [&]() { return args.value(arg); };
+      if (arg == "--help" || arg == "-h") {
+        std::fputs(kUsage, stdout);
+        std::exit(0);
+      } else if (arg == "--images") o.images = value();
+      else if (arg == "--bag") o.bag = value();
+      else if (arg == "--image-topic") o.image_topic = value();
+      else if (arg == "--camera-info-topic") o.camera_info_topic = value();
+      else if (arg == "--output") o.output = value();
+      else if (arg == "--diagnostics") o.diagnostics = value();
+      else if (arg == "--config") o.config = value();
+      else if (arg == "--mode") o.mode = value();
+      else if (arg == "--altitude") o.altitude = args.number(arg);
+      else if (arg == "--fx") o.fx = args.number(arg);
+      else if (arg == "--max-frames") o.max_frames = args.integer(arg);
+      else if (arg == "--quiet") o.quiet = true;
+      else usageError("unknown option '" + arg + "'");
+    }
+  } catch (const oefmt::InputError& e) {
+    usageError(e.what());
   }
   if (o.images.empty() == o.bag.empty()) usageError("give exactly one of --images and --bag");
   if (o.output.empty()) usageError("--output is required");

@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "command_line.h"
 #include "oefmt/error.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/sim/flight.h"
@@ -76,49 +77,8 @@ time and output:
   -h, --help
 exit codes: 0 success, 1 write failure, 2 invalid option)";
 
-class Arguments {
- public:
-  Arguments(int argc, char** argv) : args_(argv + 1, argv + argc) {}
-  bool done() const { return index_ >= args_.size(); }
-  std::string take() { return args_[index_++]; }
-  std::string value(const std::string& option) {
-    if (done()) throw oefmt::InputError("option " + option + " needs a value");
-    return take();
-  }
-  double number(const std::string& option) {
-    const std::string text = value(option);
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) {
-      throw oefmt::InputError("option " + option + " needs a number, got '" + text + "'");
-    }
-    return v;
-  }
-  int integer(const std::string& option) {
-    const double v = number(option);
-    if (v != std::floor(v) || std::fabs(v) > 1e9) throw oefmt::InputError("option " + option + " needs an integer");
-    return static_cast<int>(v);
-  }
-
- private:
-  std::vector<std::string> args_;
-  std::size_t index_ = 0;
-};
-
-std::vector<double> numberList(const std::string& option, const std::string& text) {
-  std::vector<double> values;
-  std::stringstream stream(text);
-  std::string item;
-  while (std::getline(stream, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) {
-      throw oefmt::InputError("option " + option + " needs numbers separated by commas, got '" + text + "'");
-    }
-    values.push_back(v);
-  }
-  return values;
-}
+using oefmt::tools::Arguments;
+using oefmt::tools::numberList;
 
 constexpr double kDeg = CV_PI / 180.0;
 
