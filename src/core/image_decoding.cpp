@@ -221,9 +221,11 @@ std::optional<cv::Mat> decodePngFast(const std::uint8_t* data, std::size_t size)
   std::vector<std::uint8_t>& rows = scratch.rows;
   if (rows.size() < filtered_bytes) rows.resize(filtered_bytes);
   std::size_t inflated = 0;
+  libdeflate_decompressor* decompressor = threadDecompressor();
+  if (decompressor == nullptr) return std::nullopt;  // out of memory: OpenCV may still manage
   const libdeflate_result inflate_result =
-      libdeflate_zlib_decompress(threadDecompressor(), compressed.data(), compressed.size(),
-                                 rows.data(), filtered_bytes, &inflated);
+      libdeflate_zlib_decompress(decompressor, compressed.data(), compressed.size(), rows.data(),
+                                 filtered_bytes, &inflated);
   if (inflate_result != LIBDEFLATE_SUCCESS || inflated != filtered_bytes) return std::nullopt;
   const UnfilterFunction unfilter = unfilterFor(bytes_per_pixel);
   if (unfilter == nullptr) return std::nullopt;
