@@ -35,9 +35,9 @@ struct CameraParameters {
   Distortion distortion;
 };
 
-/// Reads an OpenCV FileStorage YAML with Camera.fx, fy, cx, cy (required) and Camera.k1, k2, p1,
-/// p2, width, height (optional; missing distortion is 0, missing size is 0). Tolerates a missing
-/// trailing newline. Throws DatasetError naming the file and the missing or invalid key.
+/// Reads the authors' cam_param.yaml (parseYaml; "%YAML:1.0" header optional) with Camera.fx, fy,
+/// cx, cy (required) and Camera.k1, k2, p1, p2, width, height (optional; missing distortion is 0,
+/// missing size is 0). Throws DatasetError naming the file and the missing or invalid key.
 CameraParameters readCameraParameters(const std::string& path);
 
 /// Writes `camera` in the same layout (all ten Camera.* keys). Throws DatasetError on failure.

@@ -5,10 +5,9 @@
 
 #include <string>
 
-#include <opencv2/core.hpp>
-
 #include "oefmt/config.h"
 #include "oefmt/local_optimizer.h"
+#include "oefmt/yaml_map.h"
 
 namespace oefmt {
 
@@ -113,12 +112,12 @@ struct EstimatorConfig {
   void validate() const;
 };
 
-/// Reads a YAML file (OpenCV FileStorage; it must start with "%YAML:1.0" or "%YAML 1.0" + "---").
-/// Missing keys keep their defaults; unknown keys and bad values throw InputError naming the key
-/// (e.g. "registration.size") and the rule. The result is validated.
+/// Reads a YAML file of parameters (parseYaml: maps of scalars; a leading "%YAML" directive
+/// and "---" are optional). Missing keys keep their defaults; unknown keys and bad values throw
+/// InputError naming the key (e.g. "registration.size") and the rule. The result is validated.
 EstimatorConfig loadConfig(const std::string& yaml_path);
-/// The same from an already opened map node; `source` names it in error messages.
-EstimatorConfig parseConfig(const cv::FileNode& root, const std::string& source);
+/// The same from parsed YAML; `source` names it in error messages.
+EstimatorConfig parseConfig(const YamlNode& root, const std::string& source);
 /// Every parameter as YAML text that loadConfig reads back (for logging the effective values).
 std::string configToYaml(const EstimatorConfig& config);
 

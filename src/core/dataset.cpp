@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -12,7 +13,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/image_decoding.h"
-#include "oefmt/yaml_text.h"
+#include "oefmt/yaml_map.h"
 
 namespace oefmt {
 namespace fs = std::filesystem;
@@ -47,22 +48,19 @@ std::string readWholeFile(const std::string& path) {
 }
 
 // Reads Camera.<key> as a number; `fallback` when absent and not required.
-double readNumber(const cv::FileStorage& storage, const std::string& path, const char* key,
-                  bool required, double fallback) {
-  cv::FileNode node;
-  try {
-    node = storage[std::string("Camera.") + key];
-  } catch (const cv::Exception& e) {  // OpenCV asserts when the document is not a map
-    throw DatasetError("'" + path + "' is not a map of Camera.* keys: " + e.err);
-  }
-  if (node.empty() || node.isNone()) {
+double readNumber(const YamlNode& root, const std::string& path, const char* key, bool required,
+                  double fallback) {
+  const YamlNode* node = root.find(std::string("Camera.") + key);
+  if (node == nullptr || node->is_null) {
     if (required) throw DatasetError("'" + path + "' has no Camera." + key);
     return fallback;
   }
-  if (!node.isReal() && !node.isInt()) {
+  const std::string& text = node->scalar;
+  char* end = nullptr;
+  const double value = node->is_map ? 0.0 : std::strtod(text.c_str(), &end);
+  if (node->is_map || text.empty() || end != text.c_str() + text.size()) {
     throw DatasetError("'" + path + "': Camera." + key + " is not a number");
   }
-  const double value = static_cast<double>(node);
   if (!std::isfinite(value)) throw DatasetError("'" + path + "': Camera." + key + " is not finite");
   return value;
 }
@@ -81,39 +79,27 @@ std::string sizeText(cv::Size size) {
 }  // namespace
 
 CameraParameters readCameraParameters(const std::string& path) {
-  std::string text = readWholeFile(path);
+  YamlNode root;
   try {
-    checkYamlText(text, "camera parameters '" + path + "'");
+    root = parseYaml(readWholeFile(path), "camera parameters '" + path + "'");
   } catch (const InputError& e) {
     throw DatasetError(e.what());
   }
-  // OpenCV's parser wants the %YAML directive and a final newline; users' files may lack both.
-  if (text.rfind("%YAML", 0) != 0) text = "%YAML:1.0\n" + text;
-  text += "\n";
-  cv::FileStorage storage;
-  try {
-    storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    throw DatasetError("cannot parse camera parameters '" + path + "': " + e.err);
-  } catch (const std::exception& e) {  // OpenCV's parser also lets std::length_error out
-    throw DatasetError("cannot parse camera parameters '" + path + "': " + e.what());
-  }
-  if (!storage.isOpened()) throw DatasetError("cannot parse camera parameters '" + path + "'");
   CameraParameters camera;
   Intrinsics& k = camera.intrinsics;
-  k.fx = readNumber(storage, path, "fx", true, 0.0);
-  k.fy = readNumber(storage, path, "fy", true, 0.0);
-  k.cx = readNumber(storage, path, "cx", true, 0.0);
-  k.cy = readNumber(storage, path, "cy", true, 0.0);
-  k.width = static_cast<int>(std::lround(readNumber(storage, path, "width", false, 0.0)));
-  k.height = static_cast<int>(std::lround(readNumber(storage, path, "height", false, 0.0)));
+  k.fx = readNumber(root, path, "fx", true, 0.0);
+  k.fy = readNumber(root, path, "fy", true, 0.0);
+  k.cx = readNumber(root, path, "cx", true, 0.0);
+  k.cy = readNumber(root, path, "cy", true, 0.0);
+  k.width = static_cast<int>(std::lround(readNumber(root, path, "width", false, 0.0)));
+  k.height = static_cast<int>(std::lround(readNumber(root, path, "height", false, 0.0)));
   if (!(k.fx > 0.0 && k.fy > 0.0)) throw DatasetError("'" + path + "': Camera.fx and fy must be > 0");
   if (k.width < 0 || k.height < 0) throw DatasetError("'" + path + "': negative Camera.width/height");
   Distortion& d = camera.distortion;
-  d.k1 = readNumber(storage, path, "k1", false, 0.0);
-  d.k2 = readNumber(storage, path, "k2", false, 0.0);
-  d.p1 = readNumber(storage, path, "p1", false, 0.0);
-  d.p2 = readNumber(storage, path, "p2", false, 0.0);
+  d.k1 = readNumber(root, path, "k1", false, 0.0);
+  d.k2 = readNumber(root, path, "k2", false, 0.0);
+  d.p1 = readNumber(root, path, "p1", false, 0.0);
+  d.p2 = readNumber(root, path, "p2", false, 0.0);
   return camera;
 }
 

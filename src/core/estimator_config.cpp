@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "oefmt/error.h"
-#include "oefmt/yaml_text.h"
+#include "oefmt/yaml_map.h"
 
 namespace oefmt {
 namespace {
@@ -36,46 +36,37 @@ std::string trimmed(const std::string& s) {
   return s.substr(first, s.find_last_not_of(" \t") - first + 1);
 }
 
-// OpenCV's YAML reader keeps a trailing " # comment" in unquoted strings; YAML ends the value there.
-std::string withoutComment(const std::string& s) {
-  const auto hash = s.find(" #");
-  return hash == std::string::npos ? s : s.substr(0, hash);
+// Values are text (parseYaml keeps scalars as written); numbers, integers, booleans and words
+// are told apart here, with the key in the message.
+const std::string& scalarOf(const YamlNode& node, const std::string& key, const std::string& expected) {
+  if (node.is_map) badValue(key, expected + ", not a map");
+  return node.scalar;
 }
 
-// Numbers may arrive as strings: OpenCV's YAML reader keeps "1e-9" (no dot) as text.
-double readDouble(const cv::FileNode& node, const std::string& key) {
-  if (node.isInt() || node.isReal()) return static_cast<double>(node);
-  if (node.isString()) {
-    const std::string text = trimmed(withoutComment(static_cast<std::string>(node)));
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(text.c_str(), &end);
-    if (!text.empty() && end == text.c_str() + text.size() && errno == 0) return v;
-  }
-  badValue(key, "a number");
+double readDouble(const YamlNode& node, const std::string& key) {
+  const std::string text = trimmed(scalarOf(node, key, "a number"));
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno != 0) badValue(key, "a number");
+  return v;
 }
 
-int readInt(const cv::FileNode& node, const std::string& key) {
+int readInt(const YamlNode& node, const std::string& key) {
   const double v = readDouble(node, key);
   if (!(std::fabs(v) < 1e9) || v != std::floor(v)) badValue(key, "an integer");
   return static_cast<int>(v);
 }
 
-bool readBool(const cv::FileNode& node, const std::string& key) {
-  if (node.isInt()) {
-    const int v = static_cast<int>(node);
-    if (v == 0 || v == 1) return v == 1;
-  } else if (node.isString()) {
-    const std::string text = trimmed(withoutComment(static_cast<std::string>(node)));
-    if (text == "true" || text == "True" || text == "TRUE" || text == "yes" || text == "on") return true;
-    if (text == "false" || text == "False" || text == "FALSE" || text == "no" || text == "off") return false;
-  }
+bool readBool(const YamlNode& node, const std::string& key) {
+  const std::string text = trimmed(scalarOf(node, key, "true or false"));
+  if (text == "true" || text == "True" || text == "TRUE" || text == "yes" || text == "on" || text == "1") return true;
+  if (text == "false" || text == "False" || text == "FALSE" || text == "no" || text == "off" || text == "0") return false;
   badValue(key, "true or false");
 }
 
-std::string readString(const cv::FileNode& node, const std::string& key) {
-  if (!node.isString()) badValue(key, "a string");
-  return trimmed(withoutComment(static_cast<std::string>(node)));
+std::string readString(const YamlNode& node, const std::string& key) {
+  return trimmed(scalarOf(node, key, "a word"));
 }
 
 // ---- writing one value -------------------------------------------------------------------
@@ -95,7 +86,7 @@ std::string formatDouble(double v) {
 
 struct Field {
   std::string key;  // within its section
-  std::function<void(const cv::FileNode&, const std::string&)> read;
+  std::function<void(const YamlNode&, const std::string&)> read;
   std::function<std::string()> write;
 };
 
@@ -106,15 +97,15 @@ struct Section {
 };
 
 Field number(const std::string& key, double& target) {
-  return {key, [&target](const cv::FileNode& n, const std::string& k) { target = readDouble(n, k); },
+  return {key, [&target](const YamlNode& n, const std::string& k) { target = readDouble(n, k); },
           [&target] { return formatDouble(target); }};
 }
 Field integer(const std::string& key, int& target) {
-  return {key, [&target](const cv::FileNode& n, const std::string& k) { target = readInt(n, k); },
+  return {key, [&target](const YamlNode& n, const std::string& k) { target = readInt(n, k); },
           [&target] { return std::to_string(target); }};
 }
 Field boolean(const std::string& key, bool& target) {
-  return {key, [&target](const cv::FileNode& n, const std::string& k) { target = readBool(n, k); },
+  return {key, [&target](const YamlNode& n, const std::string& k) { target = readBool(n, k); },
           [&target] { return std::string(target ? "true" : "false"); }};
 }
 
@@ -122,7 +113,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
   std::vector<Section> all;
   all.push_back({"",
                  {{"mode",
-                   [&c](const cv::FileNode& n, const std::string& k) {
+                   [&c](const YamlNode& n, const std::string& k) {
                      try {
                        c.mode = parseEstimatorMode(readString(n, k));
                      } catch (const InputError&) {
@@ -147,7 +138,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   boolean("resolve_half_turn", r.resolve_half_turn),
                   number("min_texture", r.min_texture), number("min_confidence", r.min_confidence),
                   {"fft_planning",
-                   [&r](const cv::FileNode& n, const std::string& k) {
+                   [&r](const YamlNode& n, const std::string& k) {
                      const std::string v = readString(n, k);
                      if (v == "estimate") {
                        r.fft_planning = FftPlanning::kEstimate;
@@ -178,7 +169,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
   all.push_back({"optimizer",
                  {integer("max_iterations", o.max_iterations),
                   {"robust_loss",
-                   [&o](const cv::FileNode& n, const std::string& k) {
+                   [&o](const YamlNode& n, const std::string& k) {
                      const std::string v = readString(n, k);
                      if (v == "cauchy") {
                        o.robust_loss = RobustLoss::kCauchy;
@@ -222,19 +213,17 @@ std::vector<Section> sections(EstimatorConfig& c) {
 }
 
 // Reads the fields of one map node; unknown keys are errors (a typo must not pass silently).
-void readSection(const Section& section, const cv::FileNode& node, const std::string& prefix) {
+void readSection(const Section& section, const YamlNode& node, const std::string& prefix) {
   std::set<std::string> known;
   for (const Field& f : section.fields) known.insert(f.key);
-  for (auto it = node.begin(); it != node.end(); ++it) {
-    const cv::FileNode child = *it;
-    const std::string name = child.name();
-    if (prefix.empty() && child.isMap()) continue;  // a section, read separately
+  for (const auto& [name, child] : node.children) {
+    if (prefix.empty() && child.is_map) continue;  // a section, read separately
     if (known.count(name) == 0) throw InputError("unknown parameter '" + prefix + name + "'");
   }
   for (const Field& f : section.fields) {
-    const cv::FileNode child = node[f.key];
-    if (child.empty() || child.isNone()) continue;
-    f.read(child, prefix + f.key);
+    const YamlNode* child = node.find(f.key);
+    if (child == nullptr || child->is_null) continue;
+    f.read(*child, prefix + f.key);
   }
 }
 
@@ -308,17 +297,16 @@ void EstimatorConfig::validate() const {
   for (const Section& section : sections(copy)) validateSection(section);
 }
 
-EstimatorConfig parseConfig(const cv::FileNode& root, const std::string& source) {
+EstimatorConfig parseConfig(const YamlNode& root, const std::string& source) {
   EstimatorConfig config;
   try {
-    if (!root.isMap()) throw InputError("expected a map of parameters at the top level");
+    if (!root.is_map) throw InputError("expected a map of parameters at the top level");
     const std::vector<Section> all = sections(config);
     std::set<std::string> section_names;
     for (const Section& s : all) section_names.insert(s.name);
-    for (auto it = root.begin(); it != root.end(); ++it) {
-      const cv::FileNode child = *it;
-      if (child.isMap() && section_names.count(child.name()) == 0) {
-        throw InputError("unknown parameter section '" + child.name() + "'");
+    for (const auto& [name, child] : root.children) {
+      if (child.is_map && section_names.count(name) == 0) {
+        throw InputError("unknown parameter section '" + name + "'");
       }
     }
     for (const Section& s : all) {
@@ -326,10 +314,10 @@ EstimatorConfig parseConfig(const cv::FileNode& root, const std::string& source)
         readSection(s, root, "");
         continue;
       }
-      const cv::FileNode node = root[s.name];
-      if (node.empty() || node.isNone()) continue;
-      if (!node.isMap()) throw InputError("parameter section '" + s.name + "' must be a map");
-      readSection(s, node, s.name + ".");
+      const YamlNode* node = root.find(s.name);
+      if (node == nullptr || node->is_null) continue;
+      if (!node->is_map) throw InputError("parameter section '" + s.name + "' must be a map");
+      readSection(s, *node, s.name + ".");
     }
     for (const Section& s : all) validateSection(s);
   } catch (const InputError& e) {
@@ -339,27 +327,11 @@ EstimatorConfig parseConfig(const cv::FileNode& root, const std::string& source)
 }
 
 EstimatorConfig loadConfig(const std::string& yaml_path) {
-  {
-    // What OpenCV's YAML reader would hang or crash on is refused before it parses the file.
-    std::ifstream in(yaml_path, std::ios::binary);
-    if (!in) throw InputError("cannot open configuration file '" + yaml_path + "'");
-    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    checkYamlText(bytes, "configuration file '" + yaml_path + "'");
-  }
-  cv::FileStorage storage;
-  try {
-    if (!storage.open(yaml_path, cv::FileStorage::READ)) {
-      throw InputError("cannot open configuration file '" + yaml_path + "'");
-    }
-  } catch (const InputError&) {
-    throw;
-  } catch (const cv::Exception& e) {
-    throw InputError("cannot parse configuration file '" + yaml_path +
-                     "' (it must start with %YAML:1.0, or %YAML 1.0 and ---): " + e.msg);
-  } catch (const std::exception& e) {  // OpenCV's parser also lets std::length_error out
-    throw InputError("cannot parse configuration file '" + yaml_path + "': " + e.what());
-  }
-  return parseConfig(storage.root(), yaml_path);
+  std::ifstream in(yaml_path, std::ios::binary);
+  if (!in) throw InputError("cannot open configuration file '" + yaml_path + "'");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw InputError("cannot read configuration file '" + yaml_path + "'");
+  return parseConfig(parseYaml(text, "configuration file '" + yaml_path + "'"), yaml_path);
 }
 
 std::string configToYaml(const EstimatorConfig& config) {

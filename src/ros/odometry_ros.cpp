@@ -91,6 +91,7 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
   if (parameters_.use_altitude_topic) {
     altitude_subscriber_ = nh_.subscribe("altitude", 5, &OdometryRos::altitudeCallback, this);
   }
+  queue_.setCapacity(static_cast<std::size_t>(parameters_.input_buffer));
   worker_ = std::thread(&OdometryRos::workerLoop, this);
   if (parameters_.compressed) {
     // Debian packages no compressed image_transport plugin: decode CompressedImage ourselves.
@@ -109,7 +110,7 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
 }
 
 OdometryRos::~OdometryRos() {
-  slot_.shutdown();
+  queue_.shutdown();
   if (worker_.joinable()) worker_.join();
 }
 
@@ -121,6 +122,7 @@ void OdometryRos::loadParameters() {
   p.publish_tf = param(private_nh_, "publish_tf", p.publish_tf);
   p.compressed = param(private_nh_, "compressed", p.compressed);
   p.queue_size = param(private_nh_, "queue_size", p.queue_size);
+  p.input_buffer = param(private_nh_, "input_buffer", p.input_buffer);
   p.path_length = param(private_nh_, "path_length", p.path_length);
   p.camera_fx = param(private_nh_, "camera_fx", p.camera_fx);
   p.initial_altitude = param(private_nh_, "initial_altitude", p.initial_altitude);
@@ -135,6 +137,7 @@ void OdometryRos::loadParameters() {
   if (p.odom_frame == p.base_frame) fatalParameter(name_, "base_frame", "must differ from ~odom_frame");
   if (!p.camera_frame.empty() && !validFrameName(p.camera_frame)) fatalParameter(name_, "camera_frame", "must not start with '/'");
   if (p.queue_size < 1 || p.queue_size > 100) fatalParameter(name_, "queue_size", "must be in [1, 100]");
+  if (p.input_buffer < 1 || p.input_buffer > 100) fatalParameter(name_, "input_buffer", "must be in [1, 100]");
   if (p.path_length < 0) fatalParameter(name_, "path_length", "must be >= 0");
   if (!(p.camera_fx >= 0.0) || !std::isfinite(p.camera_fx)) fatalParameter(name_, "camera_fx", "must be >= 0 px (0: take it from camera_info)");
   if (!(p.initial_altitude >= 0.0) || !std::isfinite(p.initial_altitude)) fatalParameter(name_, "initial_altitude", "must be >= 0 m (0: unknown)");
@@ -177,11 +180,11 @@ void OdometryRos::compressedCallback(const sensor_msgs::CompressedImageConstPtr&
 void OdometryRos::enqueue(InputFrame frame) {
   ++frames_in_;
   input_rate_->tick();
-  if (slot_.put(std::move(frame))) {
+  if (queue_.put(std::move(frame))) {
     ++frames_dropped_;
     ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": frames arrive faster than they are processed;"
                                                " the newest wins (" << frames_dropped_.load()
-                                               << " dropped so far)");
+                                               << " dropped so far; ~input_buffer absorbs bursts)");
   }
 }
 
@@ -204,14 +207,14 @@ void OdometryRos::altitudeCallback(const sensor_msgs::RangeConstPtr& message) {
 
 bool OdometryRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   reset_requested_ = true;
-  slot_.clear();
+  queue_.clear();
   ROS_INFO_STREAM(name_ << ": reset requested");
   return true;
 }
 
 void OdometryRos::workerLoop() {
   InputFrame frame;
-  while (slot_.take(frame)) {
+  while (queue_.take(frame)) {
     try {
       process(frame);
     } catch (const std::exception& e) {

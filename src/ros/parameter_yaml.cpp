@@ -5,11 +5,10 @@
 #include <set>
 #include <sstream>
 
-#include <opencv2/core.hpp>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "oefmt/error.h"
-#include "oefmt/yaml_text.h"
+#include "oefmt/yaml_map.h"
 
 namespace oefmt {
 namespace {
@@ -44,9 +43,16 @@ void emit(std::ostream& out, const XmlRpc::XmlRpcValue& value, int indent, const
     case XmlRpc::XmlRpcValue::TypeDouble:
       out << pad << key << ": " << std::setprecision(17) << static_cast<double>(v) << "\n";
       break;
-    case XmlRpc::XmlRpcValue::TypeString:
-      out << pad << key << ": \"" << static_cast<std::string>(v) << "\"\n";
+    case XmlRpc::XmlRpcValue::TypeString: {
+      // Double-quoted, so any text stays one scalar (parseYaml undoes these escapes).
+      std::string quoted;
+      for (const char c : static_cast<std::string>(v)) {
+        if (c == '"' || c == '\\') quoted += '\\';
+        quoted += c == '\n' ? std::string("\\n") : std::string(1, c);
+      }
+      out << pad << key << ": \"" << quoted << "\"\n";
       break;
+    }
     default:
       throw InputError("parameter '" + key + "' has a type the estimator does not use");
   }
@@ -65,15 +71,7 @@ std::string estimatorYamlFromParameters(const ros::NodeHandle& nh) {
 }
 
 EstimatorConfig parseConfigText(const std::string& yaml, const std::string& source) {
-  checkYamlText(yaml, source);
-  cv::FileStorage storage;
-  try {
-    storage.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    throw InputError(source + ": not valid YAML: " + e.what());
-  }
-  if (!storage.isOpened()) throw InputError(source + ": not valid YAML");
-  return parseConfig(storage.root(), source);
+  return parseConfig(parseYaml(yaml, source), source);
 }
 
 }  // namespace oefmt

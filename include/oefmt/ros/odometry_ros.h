@@ -29,7 +29,7 @@
 
 #include "oefmt/estimator.h"
 #include "oefmt/estimator_config.h"
-#include "oefmt/ros/latest_slot.h"
+#include "oefmt/ros/frame_queue.h"
 #include "oefmt/stamp_guard.h"
 
 namespace oefmt {
@@ -43,6 +43,7 @@ struct RosParameters {
   bool publish_tf = true;
   bool compressed = false;           ///< subscribe to image/compressed instead of image
   int queue_size = 2;                ///< subscriber queue of image, camera_info
+  int input_buffer = 1;              ///< frames waiting for the worker (1: the newest wins)
   int path_length = 2000;            ///< poses kept in the published path (0 = no path)
   /// Focal length [px] of the camera images, used when no camera_info arrives. (Not the YAML's
   /// `fx`, which is the working image's and is set from this or from camera_info.)
@@ -116,7 +117,7 @@ class OdometryRos {
   std::optional<double> altitude_from_topic_;
 
   // Worker state (worker thread only).
-  LatestSlot<InputFrame> slot_;
+  FrameQueue<InputFrame> queue_;
   std::thread worker_;
   std::unique_ptr<Estimator> estimator_;
   StampGuard stamp_guard_;

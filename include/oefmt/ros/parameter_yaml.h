@@ -11,7 +11,7 @@
 
 namespace oefmt {
 
-/// YAML text (OpenCV FileStorage dialect) of the estimator keys found under `nh`: the top-level
+/// YAML text (the parseYaml subset) of the estimator keys found under `nh`: the top-level
 /// keys of config/default.yaml (mode, altitude, registration, ...); other parameters of the
 /// node (frames, topics) are left out.
 std::string estimatorYamlFromParameters(const ros::NodeHandle& nh);
