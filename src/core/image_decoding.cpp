@@ -246,8 +246,9 @@ cv::Mat decodeImage(const std::uint8_t* data, std::size_t size) {
   if (data == nullptr || size == 0) return cv::Mat();
   if (std::optional<cv::Mat> image = decodePngFast(data, size)) return std::move(*image);
   if (const std::optional<PngHeader> header = readHeader(data, size)) {
-    const std::int64_t pixels = static_cast<std::int64_t>(header->width) * header->height;
-    if (pixels > kMaxDecodedPixels) {
+    // Both sides are below 2^32: their product fits an unsigned 64-bit integer.
+    const std::uint64_t pixels = std::uint64_t{header->width} * header->height;
+    if (pixels > static_cast<std::uint64_t>(kMaxDecodedPixels)) {
       throw InputError("PNG image of " + std::to_string(header->width) + "x" + std::to_string(header->height) +
                        " pixels: over the limit of " + std::to_string(kMaxDecodedPixels) + " pixels");
     }

@@ -221,6 +221,19 @@ TEST(FastPng, HugeHeaderIsAClearError) {
   }
 }
 
+// Found by fuzz_image: a header of 3623878655 x 4294916655 overflowed the pixel count.
+TEST(FastPng, HeaderSidesNearTwoToThe32AreAClearError) {
+  Bytes png = {137, 80, 78, 71, 13, 10, 26, 10};
+  Bytes header;
+  put32(header, 0xd7ffffffu);
+  put32(header, 0xffff3a2fu);
+  header.insert(header.end(), {8, 2, 0, 0, 0});
+  putChunk(png, "IHDR", header);
+  putChunk(png, "IEND", {});
+  EXPECT_FALSE(decodePngFast(png.data(), png.size()).has_value());
+  EXPECT_THROW(decodeImage(png.data(), png.size()), InputError);
+}
+
 TEST(FastPng, ReadImageFileMissingOrEmptyGivesEmpty) {
   EXPECT_TRUE(readImageFile("/nonexistent/oefmt/image.png").empty());
   EXPECT_TRUE(readImageFile("/dev/null").empty());
