@@ -128,7 +128,7 @@ class Parser {
       if (colon >= t.size() || t[colon] != ':') fail(line, "expected ':' after the quoted key");
     } else {
       for (std::size_t i = 0; i < t.size(); ++i) {
-        if (t[i] == ':' && (i + 1 == t.size() || t[i + 1] == ' ')) {
+        if (t[i] == ':' && (i + 1 == t.size() || t[i + 1] == ' ' || t[i + 1] == '\t')) {
           colon = i;
           break;
         }
@@ -141,7 +141,7 @@ class Parser {
       }
     }
     std::size_t value = colon + 1;
-    while (value < t.size() && t[value] == ' ') ++value;
+    while (value < t.size() && (t[value] == ' ' || t[value] == '\t')) ++value;
     rest = t.substr(value);
   }
 

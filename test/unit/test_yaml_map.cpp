@@ -44,6 +44,10 @@ TEST(YamlMap, NestedMapsScalarsCommentsAndQuotes) {
   EXPECT_EQ(camera.find("Camera.fx")->scalar, "2955.7");
   EXPECT_EQ(camera.find("Camera.type")->scalar, "PinHole");
   EXPECT_TRUE(parseYaml("", "empty").children.empty());
+  // Windows line ends and a tab after the colon.
+  const YamlNode windows = parseYaml("a:\t1\r\nb: 2\r\n", "w");
+  EXPECT_EQ(windows.find("a")->scalar, "1");
+  EXPECT_EQ(windows.find("b")->scalar, "2");
 }
 
 TEST(YamlMap, WhatItDoesNotTakeIsRefusedWithTheLine) {
