@@ -16,8 +16,8 @@ void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Ma
                           bool half_turn = false);
 
 /// The same cross power, modulated so that its inverse FFT (Fft2d::inverse) is directly the
-/// centred surface of centredSurface(): fftshift and the 1/N^2 folded into the spectrum as
-/// (-1)^(fx + fy) / N^2, which saves a pass and a buffer per correlation.
+/// centred surface fftshift(correlation) / N^2, where a shift t peaks at (N/2, N/2) + t:
+/// fftshift and 1/N^2 are folded into the spectrum as (-1)^(fx + fy) / N^2 (no extra pass).
 void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
                        bool half_turn = false);
 
@@ -27,14 +27,11 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
                          const Fft2d& small, cv::Mat2f& scratch_spectrum,
                          cv::Mat1f& scratch_surface);
 
-/// Sums over a surface, gathered while it is written (for the peak-to-sidelobe ratio).
+/// Sums over a surface, gathered by findPeak (for the peak-to-sidelobe ratio).
 struct SurfaceStats {
   double abs_sum = 0.0;     ///< sum of |v|
   double square_sum = 0.0;  ///< sum of v^2
 };
-
-/// surface = fftshift(correlation) / N^2: a shift t peaks at (N/2, N/2) + t. Signed values.
-SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface);
 
 /// Integer peak of |surface| with a sub-pixel refinement.
 struct SurfacePeak {
@@ -52,9 +49,8 @@ struct SurfacePeak {
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats = nullptr);
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
-/// peak. About 15 for unrelated textures at N = 512, hundreds for a clean registration.
-double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak);
-/// The same from sums already gathered by centredSurface.
+/// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at
+/// N = 512, hundreds for a clean registration.
 double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak,
                            const SurfaceStats& stats);
 

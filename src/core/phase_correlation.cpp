@@ -96,75 +96,48 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
   return std::max(max_value, -min_value) / (static_cast<double>(m) * m);
 }
 
-SurfaceStats centredSurface(const cv::Mat1f& correlation, cv::Mat1f& surface) {
-  const int n = correlation.rows;
-  const int half = n / 2;
-  const float scale = 1.0f / (static_cast<float>(n) * static_cast<float>(n));
-  surface.create(n, n);
-  SurfaceStats stats;
-  for (int r = 0; r < n; ++r) {
-    const float* in = correlation[(r + half) % n];
-    float* out = surface[r];
-    float abs_sum = 0.0f, square_sum = 0.0f;  // per row in float, across rows in double
-#pragma omp simd reduction(+ : abs_sum, square_sum)
-    for (int c = 0; c < n; ++c) {
-      const float v = in[c < half ? c + half : c - half] * scale;
-      out[c] = v;
+SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats) {
+  if (surface.empty()) throw InputError("findPeak: empty surface");
+  // One pass for the extremes and the sums: per row vectorised reductions, and the row is
+  // searched for the position only when it holds a new extreme (the first, as cv::minMaxLoc).
+  SurfaceStats sums;
+  float min_value = surface(0, 0), max_value = surface(0, 0);
+  cv::Point min_at, max_at;
+  for (int r = 0; r < surface.rows; ++r) {
+    const float* row = surface[r];
+    float row_max = row[0], row_min = row[0], abs_sum = 0.0f, square_sum = 0.0f;
+#pragma omp simd reduction(max : row_max) reduction(min : row_min) reduction(+ : abs_sum, square_sum)
+    for (int c = 0; c < surface.cols; ++c) {
+      const float v = row[c];
+      row_max = std::max(row_max, v);
+      row_min = std::min(row_min, v);
       abs_sum += std::fabs(v);
       square_sum += v * v;
     }
-    stats.abs_sum += abs_sum;
-    stats.square_sum += square_sum;
-  }
-  return stats;
-}
-
-SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats) {
-  if (surface.empty()) throw InputError("findPeak: empty surface");
-  double min_value = 0.0, max_value = 0.0;
-  cv::Point min_at, max_at;
-  if (stats == nullptr) {
-    cv::minMaxLoc(surface, &min_value, &max_value, &min_at, &max_at);
-  } else {
-    // One pass for the extremes and the sums: per row vectorised reductions, and the row is
-    // searched for the position only when it holds a new extreme.
-    *stats = SurfaceStats();
-    min_value = max_value = surface(0, 0);
-    for (int r = 0; r < surface.rows; ++r) {
-      const float* row = surface[r];
-      float row_max = row[0], row_min = row[0], abs_sum = 0.0f, square_sum = 0.0f;
-#pragma omp simd reduction(max : row_max) reduction(min : row_min) reduction(+ : abs_sum, square_sum)
-      for (int c = 0; c < surface.cols; ++c) {
-        const float v = row[c];
-        row_max = std::max(row_max, v);
-        row_min = std::min(row_min, v);
-        abs_sum += std::fabs(v);
-        square_sum += v * v;
-      }
-      stats->abs_sum += abs_sum;
-      stats->square_sum += square_sum;
-      // (A NaN is never found: column 0 then, as the sums already carry the NaN.)
-      auto column_of = [&](float value) {
-        const int c = static_cast<int>(std::find(row, row + surface.cols, value) - row);
-        return c < surface.cols ? c : 0;
-      };
-      if (row_max > max_value || r == 0) {
-        max_value = row_max;
-        max_at = cv::Point(column_of(row_max), r);
-      }
-      if (row_min < min_value || r == 0) {
-        min_value = row_min;
-        min_at = cv::Point(column_of(row_min), r);
-      }
+    sums.abs_sum += abs_sum;
+    sums.square_sum += square_sum;
+    // (A NaN is never found: column 0 then, as the sums already carry the NaN.)
+    auto column_of = [&](float value) {
+      const int c = static_cast<int>(std::find(row, row + surface.cols, value) - row);
+      return c < surface.cols ? c : 0;
+    };
+    if (row_max > max_value || r == 0) {
+      max_value = row_max;
+      max_at = cv::Point(column_of(row_max), r);
+    }
+    if (row_min < min_value || r == 0) {
+      min_value = row_min;
+      min_at = cv::Point(column_of(row_min), r);
     }
   }
+  if (stats != nullptr) *stats = sums;
   const bool negative = -min_value > max_value;
   const cv::Point at = negative ? min_at : max_at;
   SurfacePeak peak;
   peak.row = at.y;
   peak.col = at.x;
   const float sign = negative ? -1.0f : 1.0f;
-  peak.value = static_cast<float>(negative ? -min_value : max_value);
+  peak.value = negative ? -min_value : max_value;
   auto sample = [&](int r, int c) -> float {
     r = wrap(r, surface.rows);
     if (cyclic_cols) {
@@ -179,13 +152,6 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
   peak.sub_col = peak.col + sincRatioOffset(sample(peak.row, peak.col - 1), peak.value,
                                             sample(peak.row, peak.col + 1));
   return peak;
-}
-
-double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak) {
-  SurfaceStats stats;
-  stats.abs_sum = cv::norm(surface, cv::NORM_L1);
-  stats.square_sum = cv::norm(surface, cv::NORM_L2SQR);
-  return peakToSidelobeRatio(surface, peak, stats);
 }
 
 double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak,
