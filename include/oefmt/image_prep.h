@@ -36,6 +36,10 @@ cv::Mat1f toGreyFloat(const cv::Mat& image, ChannelOrder order = ChannelOrder::k
 /// detail to register and are refused rather than blown up to the working size.
 constexpr int kMinImageSide = 64;
 
+/// Throws InputError, with the size, for an empty image or one whose square is under
+/// kMinImageSide (prepareImage's own check, for callers that must refuse such a frame first).
+void requireRegistrableSize(const cv::Mat& image);
+
 /// Centre-crops the image to a min(W, H) square, converts it to grey float (toGreyFloat) and
 /// resizes it to size x size (area interpolation when shrinking, bilinear when growing).
 /// Non-finite pixels are replaced and counted.

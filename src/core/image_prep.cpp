@@ -74,17 +74,21 @@ cv::Mat1f toGreyFloat(const cv::Mat& image, ChannelOrder order) {
   return out;
 }
 
-PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
-  if (size < 64 || size % 2 != 0) {
-    throw InputError("working size must be even and >= 64, got " + std::to_string(size));
-  }
+void requireRegistrableSize(const cv::Mat& image) {
   if (image.empty()) throw InputError("image is empty");
-  const int side = std::min(image.cols, image.rows);
-  if (side < kMinImageSide) {
+  if (std::min(image.cols, image.rows) < kMinImageSide) {
     throw InputError("image of " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                      " pixels: its centre square must be at least " + std::to_string(kMinImageSide) +
                      " px (too little detail to register)");
   }
+}
+
+PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
+  if (size < 64 || size % 2 != 0) {
+    throw InputError("working size must be even and >= 64, got " + std::to_string(size));
+  }
+  requireRegistrableSize(image);
+  const int side = std::min(image.cols, image.rows);
   // Crop first (a view), then convert: a 4056 x 3040 frame converts only its centre square.
   const cv::Rect square((image.cols - side) / 2, (image.rows - side) / 2, side, side);
   const bool already_square = image.cols == image.rows;

@@ -247,11 +247,8 @@ cv::Mat OdometryRos::decode(const InputFrame& frame) {
 }
 
 bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image) {
-  // Refused before it could restart the odometry (the core would refuse it too).
-  if (std::min(image.cols, image.rows) < kMinImageSide) {
-    throw InputError("image of " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                     " pixels: under the " + std::to_string(kMinImageSide) + " px minimum");
-  }
+  // Refused before it could restart the odometry (prepareImage's own check).
+  requireRegistrableSize(image);
   if (!input_size_.empty() && image.size() != input_size_) {
     resetEstimator("the image size changed from " + std::to_string(input_size_.width) + "x" +
                    std::to_string(input_size_.height) + " to " + std::to_string(image.cols) +
