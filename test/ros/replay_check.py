@@ -162,13 +162,18 @@ class ReplayCheck(unittest.TestCase):
                      m.pose.pose.position.z, m.pose.pose.orientation.z, m.pose.pose.orientation.w)
                     for m in self.odometry]
 
-    def odometry_counters(self):
-        """The node's own counts from its last /diagnostics status, for failure messages."""
+    def last_odometry_status(self):
+        """The node's last "odometry" status on /diagnostics, or None."""
         with self.lock:
             statuses = [s for array in self.diagnostics for s in array.status if "odometry" in s.name]
-        if not statuses:
+        return statuses[-1] if statuses else None
+
+    def odometry_counters(self):
+        """The node's own counts from its last /diagnostics status, for failure messages."""
+        status = self.last_odometry_status()
+        if status is None:
             return "no /diagnostics status"
-        return ", ".join(f"{kv.key}: {kv.value}" for kv in statuses[-1].values)
+        return ", ".join(f"{kv.key}: {kv.value}" for kv in status.values)
 
     def test_every_frame_gives_odometry(self):
         stamps = [p[0] for p in self.poses()]
@@ -220,11 +225,10 @@ class ReplayCheck(unittest.TestCase):
         self.assertEqual(translation[-1], (512, 512))
 
     def test_diagnostics_ok(self):
-        with self.lock:
-            statuses = [s for array in self.diagnostics for s in array.status if "odometry" in s.name]
-        self.assertTrue(statuses, "no odometry status on /diagnostics")
-        self.assertEqual(statuses[-1].level, DiagnosticStatus.OK, statuses[-1].message)
-        values = {kv.key: kv.value for kv in statuses[-1].values}
+        status = self.last_odometry_status()
+        self.assertIsNotNone(status, "no odometry status on /diagnostics")
+        self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
+        values = {kv.key: kv.value for kv in status.values}
         rospy.loginfo("replay: latency median %s ms, 95th percentile %s ms, drops %s",
                       values.get("latency median [ms]"), values.get("latency 95th percentile [ms]"),
                       values.get("frames dropped (newest wins)"))
