@@ -9,7 +9,23 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/registration.h"
+
 namespace oefmt_fuzz {
+
+// Working size of the targets that register images: small, so that a run tries many inputs.
+constexpr int kSize = 64;
+
+// One registrar per process (ESTIMATE plans: no FFTW timing inside a fuzzing run).
+inline oefmt::Registrar& registrar() {
+  static oefmt::Registrar instance([] {
+    oefmt::RegistrationConfig config;
+    config.size = kSize;
+    config.fft_planning = oefmt::FftPlanning::kEstimate;
+    return config;
+  }());
+  return instance;
+}
 
 [[noreturn]] inline void fail(const char* what, double value) {
   std::fprintf(stderr, "CONTRACT VIOLATION: %s (value %g)\n", what, value);

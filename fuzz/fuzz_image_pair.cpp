@@ -18,17 +18,8 @@
 
 namespace {
 
-constexpr int kSize = 64;
-
-oefmt::Registrar& registrar() {
-  static oefmt::Registrar instance([] {
-    oefmt::RegistrationConfig config;
-    config.size = kSize;
-    config.fft_planning = oefmt::FftPlanning::kEstimate;
-    return config;
-  }());
-  return instance;
-}
+using oefmt_fuzz::kSize;
+using oefmt_fuzz::registrar;
 
 // Fills a frame by cycling through bytes: as intensities (k = 1) or float bit patterns (k = 4).
 cv::Mat1f frameFrom(const std::vector<uint8_t>& bytes, bool raw_floats) {
