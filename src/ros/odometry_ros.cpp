@@ -162,22 +162,19 @@ EstimatorConfig OdometryRos::loadEstimatorConfig() {
 void OdometryRos::imageCallback(const sensor_msgs::ImageConstPtr& message) {
   InputFrame frame;
   frame.image = message;
-  frame.stamp = message->header.stamp;
-  frame.frame_id = message->header.frame_id;
-  frame.received = ros::WallTime::now();
-  enqueue(std::move(frame));
+  enqueue(std::move(frame), message->header);
 }
 
 void OdometryRos::compressedCallback(const sensor_msgs::CompressedImageConstPtr& message) {
   InputFrame frame;
   frame.compressed = message;
-  frame.stamp = message->header.stamp;
-  frame.frame_id = message->header.frame_id;
-  frame.received = ros::WallTime::now();
-  enqueue(std::move(frame));
+  enqueue(std::move(frame), message->header);
 }
 
-void OdometryRos::enqueue(InputFrame frame) {
+void OdometryRos::enqueue(InputFrame frame, const std_msgs::Header& header) {
+  frame.stamp = header.stamp;
+  frame.frame_id = header.frame_id;
+  frame.received = ros::WallTime::now();
   ++frames_in_;
   input_rate_->tick();
   if (queue_.put(std::move(frame))) {

@@ -22,6 +22,7 @@
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/Range.h>
+#include <std_msgs/Header.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -82,7 +83,8 @@ class OdometryRos {
   void cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& message);
   void altitudeCallback(const sensor_msgs::RangeConstPtr& message);
   bool resetService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
-  void enqueue(InputFrame frame);
+  /// Stamps the frame from its message header and hands it to the worker.
+  void enqueue(InputFrame frame, const std_msgs::Header& header);
   void workerLoop();
   void process(const InputFrame& frame);
   bool prepareEstimator(const InputFrame& frame, const cv::Mat& image);
