@@ -51,6 +51,21 @@ double sincRatioOffset(float left, float centre, float right) {
   return std::clamp(offset, -0.5, 0.5);
 }
 
+// Sub-sample offset of a peak widened by resampling. Where one neighbour dominates, the peak is
+// still Dirichlet-like and the ratio is right; where both neighbours are alike (offsets near a
+// whole bin), the ratio flips between the sides and the three-point centre of mass, continuous
+// there, takes over. The weight is the squared asymmetry of the (positive parts of the)
+// neighbours.
+double widenedPeakOffset(float left, float centre, float right) {
+  const double total = double(left) + centre + right;
+  if (centre <= 0.0f || !(total > 0.0)) return 0.0;
+  const double centre_of_mass = std::clamp((double(right) - left) / total, -0.5, 0.5);
+  const double l = std::max(0.0f, left), r = std::max(0.0f, right);
+  const double asymmetry = l + r > 0.0 ? (r - l) / (r + l) : 1.0;
+  const double weight = asymmetry * asymmetry;
+  return weight * sincRatioOffset(left, centre, right) + (1.0 - weight) * centre_of_mass;
+}
+
 }  // namespace
 
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
@@ -96,7 +111,8 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
   return std::max(max_value, -min_value) / (static_cast<double>(m) * m);
 }
 
-SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats) {
+SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats,
+                     PeakShape shape) {
   if (surface.empty()) throw InputError("findPeak: empty surface");
   // One pass for the extremes and the sums: per row vectorised reductions, and the row is
   // searched for the position only when it holds a new extreme (the first, as cv::minMaxLoc).
@@ -147,10 +163,11 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
     }
     return sign * surface(r, c);
   };
-  peak.sub_row = peak.row + sincRatioOffset(sample(peak.row - 1, peak.col), peak.value,
-                                            sample(peak.row + 1, peak.col));
-  peak.sub_col = peak.col + sincRatioOffset(sample(peak.row, peak.col - 1), peak.value,
-                                            sample(peak.row, peak.col + 1));
+  const auto offset = shape == PeakShape::kDirichlet ? sincRatioOffset : widenedPeakOffset;
+  peak.sub_row = peak.row + offset(sample(peak.row - 1, peak.col), peak.value,
+                                   sample(peak.row + 1, peak.col));
+  peak.sub_col = peak.col + offset(sample(peak.row, peak.col - 1), peak.value,
+                                   sample(peak.row, peak.col + 1));
   return peak;
 }
 

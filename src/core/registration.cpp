@@ -140,7 +140,7 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
   // correlation's energy sits at high frequencies.
   context_->fft().inverse(cross_power_, surface_);
   SurfaceStats stats;
-  const SurfacePeak peak = findPeak(surface_, true, &stats);
+  const SurfacePeak peak = findPeak(surface_, true, &stats, PeakShape::kBroadened);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
   result.rotation = (peak.sub_row - n / 2) * CV_PI / n;

@@ -73,6 +73,27 @@ INSTANTIATE_TEST_SUITE_P(Shifts, PureShift,
                                            ShiftCase{28.5, -0.3}, ShiftCase{0.4, 39.6},
                                            ShiftCase{-25.7, -28.1}, ShiftCase{-38.0, 0.2}));
 
+// Consecutive frames of a flight are shifted by 60-100 px with no rotation or zoom: whole-bin
+// offsets on the log-polar surface, where a refinement that jumps between the peak's sides would
+// add +-0.05 deg and +-5e-4 of ln zoom of noise to every frame (the heading and altitude drift).
+TEST(Registration, FlightSizedShiftsLeaveRotationAndZoomAtZero) {
+  double log_zoom_sum = 0.0;
+  constexpr int kDirections = 8;
+  for (int i = 0; i < kDirections; ++i) {
+    const double direction = 2.0 * CV_PI * (i + 0.3) / kDirections;
+    const double length = 60.0 + 5.0 * i;
+    sim::ViewMotion motion;
+    motion.shift = {length * std::cos(direction), length * std::sin(direction)};
+    const auto pair = test::warpedPair(motion);
+    const PairRegistration r = test::registerImages(pair.older, pair.newer);
+    ASSERT_EQ(r.status, RegistrationStatus::kOk);
+    EXPECT_NEAR(deg(r.rotation), 0.0, 0.01) << "shift " << motion.shift;
+    EXPECT_NEAR(std::log(r.zoom), 0.0, 2e-4) << "shift " << motion.shift;
+    log_zoom_sum += std::log(r.zoom);
+  }
+  EXPECT_NEAR(log_zoom_sum / kDirections, 0.0, 1e-4);
+}
+
 class PureRotation : public ::testing::TestWithParam<double> {};
 
 TEST_P(PureRotation, AngleWithinFiveHundredthsOfADegree) {

@@ -110,6 +110,59 @@ TEST(PhaseCorrelation, OnePassPeakFindsNegativePeaksAndTheFirstOfTies) {
   EXPECT_EQ(peak.col, 3);
 }
 
+// A sinc peak widened by a Gaussian blur of `sigma` bins (as resampling widens the log-polar
+// correlation peak), centred at (row, col) + offset on both axes.
+cv::Mat1f widenedPeakSurface(int row, int col, double offset, double sigma) {
+  auto profile = [sigma](double x) {
+    double sum = 0.0, weights = 0.0;
+    for (double u = -6.0 * sigma; u <= 6.0 * sigma; u += 0.01) {
+      const double w = std::exp(-0.5 * u * u / (sigma * sigma));
+      const double t = CV_PI * (x - u);
+      sum += w * (std::fabs(t) < 1e-12 ? 1.0 : std::sin(t) / t);
+      weights += w;
+    }
+    return sum / weights;
+  };
+  cv::Mat1f surface(16, 16);
+  for (int r = 0; r < surface.rows; ++r) {
+    for (int c = 0; c < surface.cols; ++c) {
+      surface(r, c) = static_cast<float>(profile(r - row - offset) * profile(c - col - offset));
+    }
+  }
+  return surface;
+}
+
+// At whole-bin offsets both neighbours of a widened peak are alike, and the larger-neighbour
+// ratio jumps from one side to the other (here by ~0.5 bin between offsets -0.05 and +0.05);
+// the widened-peak refinement follows the offset continuously.
+TEST(PhaseCorrelation, WidenedPeakRefinementIsContinuousAtWholeBins) {
+  for (double sigma : {0.4, 0.6}) {
+    double previous = -1.0;
+    for (double offset = -0.3; offset <= 0.301; offset += 0.05) {
+      const cv::Mat1f surface = widenedPeakSurface(8, 7, offset, sigma);
+      const SurfacePeak peak = findPeak(surface, true, nullptr, PeakShape::kBroadened);
+      ASSERT_EQ(peak.row, 8);
+      ASSERT_EQ(peak.col, 7);
+      EXPECT_NEAR(peak.sub_row - 8, offset, 0.09) << "sigma " << sigma;
+      EXPECT_NEAR(peak.sub_col - 7, offset, 0.09) << "sigma " << sigma;
+      EXPECT_GT(peak.sub_col, previous) << "not monotonic at offset " << offset;
+      previous = peak.sub_col;
+    }
+  }
+  const SurfacePeak ratio = findPeak(widenedPeakSurface(8, 7, 0.0, 0.6), true, nullptr,
+                                     PeakShape::kDirichlet);
+  EXPECT_GT(std::fabs(ratio.sub_col - 7), 0.15) << "the ratio's jump this refinement avoids";
+}
+
+// An ideal shift: the Dirichlet refinement is exact, and the widened-peak one stays close.
+TEST(PhaseCorrelation, PeakRefinementsOnAnIdealSincPeak) {
+  for (double offset : {-0.4, -0.2, 0.1, 0.3}) {
+    const cv::Mat1f surface = widenedPeakSurface(8, 7, offset, 1e-3);
+    EXPECT_NEAR(findPeak(surface, true).sub_col - 7, offset, 0.01);
+    EXPECT_NEAR(findPeak(surface, true, nullptr, PeakShape::kBroadened).sub_col - 7, offset, 0.03);
+  }
+}
+
 // The CPU-specific kernel (AVX2 + FMA where the CPU has it) and the portable one agree up to
 // float rounding, including the border blocks that fall back to scalar samples. (On a CPU
 // without AVX2 both are the portable kernel and the test checks nothing more.)
