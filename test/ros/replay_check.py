@@ -74,6 +74,9 @@ class ReplayCheck(unittest.TestCase):
         # With ~mount_yaw, the camera body is mounted turned by that yaw in base_link (static
         # TF base_link -> camera_optical): the node's odometry is the offline one turned by it.
         cls.mount_yaw = float(rospy.get_param("~mount_yaw", 0.0))
+        # The debug surfaces are rendered only while subscribed; a latency benchmark measures
+        # the odometry path without them (~debug_images false).
+        cls.debug_subscribed = rospy.get_param("~debug_images", True)
         cls.workdir = tempfile.mkdtemp(prefix="oefmt_rostest_")
         cls.flight = os.path.join(cls.workdir, "flight")
         cls.bag = os.path.join(cls.workdir, "flight.bag")
@@ -96,10 +99,13 @@ class ReplayCheck(unittest.TestCase):
             rospy.Subscriber("/path", Path, lambda m: cls.store(cls.paths, m), queue_size=5),
         ]
         rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: cls.store(cls.diagnostics, m), queue_size=50)
-        rospy.Subscriber("/debug/rotation_zoom_psd", Image,
-                         lambda m: cls.store(cls.debug_images["rotation_zoom"], (m.width, m.height)), queue_size=5)
-        rospy.Subscriber("/debug/translation_psd", Image,
-                         lambda m: cls.store(cls.debug_images["translation"], (m.width, m.height)), queue_size=5)
+        if cls.debug_subscribed:
+            rospy.Subscriber("/debug/rotation_zoom_psd", Image,
+                             lambda m: cls.store(cls.debug_images["rotation_zoom"], (m.width, m.height)),
+                             queue_size=5)
+            rospy.Subscriber("/debug/translation_psd", Image,
+                             lambda m: cls.store(cls.debug_images["translation"], (m.width, m.height)),
+                             queue_size=5)
         cls.tf_buffer = tf2_ros.Buffer(cache_time=rospy.Duration(600))
         cls.tf_listener = tf2_ros.TransformListener(cls.tf_buffer)
 
@@ -216,6 +222,8 @@ class ReplayCheck(unittest.TestCase):
         self.assertEqual(len(paths[-1].poses), self.frames)
 
     def test_debug_surfaces_while_subscribed(self):
+        if not self.debug_subscribed:
+            self.skipTest("~debug_images is false: not subscribed")
         with self.lock:
             rotation_zoom = list(self.debug_images["rotation_zoom"])
             translation = list(self.debug_images["translation"])
@@ -229,9 +237,11 @@ class ReplayCheck(unittest.TestCase):
         self.assertIsNotNone(status, "no odometry status on /diagnostics")
         self.assertEqual(status.level, DiagnosticStatus.OK, status.message)
         values = {kv.key: kv.value for kv in status.values}
-        rospy.loginfo("replay: latency median %s ms, 95th percentile %s ms, drops %s",
-                      values.get("latency median [ms]"), values.get("latency 95th percentile [ms]"),
-                      values.get("frames dropped (newest wins)"))
+        rospy.loginfo("replay: latency median %s ms, 95th percentile %s ms, drops %s, "
+                      "debug images %s", values.get("latency median [ms]"),
+                      values.get("latency 95th percentile [ms]"),
+                      values.get("frames dropped (newest wins)"),
+                      "subscribed" if self.debug_subscribed else "not subscribed")
         self.assertEqual(values.get("frames dropped (newest wins)"), "0")
 
     def test_accuracy_against_ground_truth(self):
