@@ -34,7 +34,21 @@ class Fft2d {
   /// image = IFFT(spectrum) * size^2 (unnormalised). spectrum is overwritten (FFTW c2r).
   void inverse(cv::Mat2f& spectrum, cv::Mat1f& image) const;
 
+  /// In-place transforms, 9-17 % faster here than out-of-place (FFTW's out-of-place 2-D real
+  /// plans copy through a buffer). A size x (size/2 + 1) complex buffer holds the spectrum; its
+  /// realView() (size x size floats, rows padded to the buffer's stride) holds the image.
+  /// Allocates `buffer` if it has the wrong shape; the image is to be written after that.
+  void allocateInPlace(cv::Mat2f& buffer) const;
+  /// realView(buffer) -> buffer = FFT(image).
+  void forwardInPlace(cv::Mat2f& buffer) const;
+  /// buffer -> realView(buffer) = IFFT(spectrum) * size^2.
+  void inverseInPlace(cv::Mat2f& buffer) const;
+  /// The image rows inside an in-place buffer (shares its memory; not continuous).
+  cv::Mat1f realView(cv::Mat2f& buffer) const;
+
  private:
+  void makeOutOfPlacePlans() const;
+
   struct Plans;
   int size_;
   std::unique_ptr<Plans> plans_;

@@ -38,8 +38,8 @@ class MultiZoomTranslator {
  private:
   std::shared_ptr<const SpectralContext> context_;
   EfmtConfig config_;
-  cv::Mat1f warped_, surface_, polar_, fused_;
-  cv::Mat2f warped_spectrum_, cross_power_;
+  cv::Mat1f polar_, fused_;
+  cv::Mat2f warped_spectrum_, cross_power_;  // in-place FFT buffers (images in their rows)
 };
 
 }  // namespace oefmt

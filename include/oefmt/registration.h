@@ -91,7 +91,8 @@ class Registrar {
   SpectraBuilder builder_;
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_;
-  cv::Mat1f warped_, surface_, small_surface_, polar_;
+  cv::Mat1f surface_;  // the last correlation surface: a view of cross_power_ (in-place FFT)
+  cv::Mat1f small_surface_, polar_;
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;
 };

@@ -82,7 +82,6 @@ class SpectraBuilder {
 
  private:
   std::shared_ptr<const SpectralContext> context_;
-  cv::Mat1f windowed_;  // apodized image, then the log-polar image
   cv::Mat1f magnitude_;
 };
 

@@ -91,8 +91,15 @@ bool exportFftWisdom(const std::string& path) {
 }
 
 struct Fft2d::Plans {
+  fftwf_plan forward_in_place = nullptr;
+  fftwf_plan inverse_in_place = nullptr;
+  // Out-of-place plans are made on first use: the pipeline runs in place, and planning them
+  // without wisdom costs about a second at N = 512.
+  std::once_flag out_of_place_made;
   fftwf_plan forward = nullptr;
   fftwf_plan inverse = nullptr;
+  unsigned flags = 0;
+  bool measured = false;  // FFTW_MEASURE is 0: remember whether wisdom applies
 };
 
 Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_unique<Plans>()) {
@@ -100,7 +107,6 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
     throw InputError("Fft2d: size must be even and >= 2, got " + std::to_string(size));
   }
   const unsigned flags = planning == FftPlanning::kMeasure ? FFTW_MEASURE : FFTW_ESTIMATE;
-  cv::Mat1f image(size, size);
   cv::Mat2f spectrum(size, spectrumCols());
   std::lock_guard<std::mutex> lock(plannerMutex());
   static bool wisdom_imported = false;  // guarded by the planner mutex
@@ -109,23 +115,50 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
     importWisdomLocked(wisdom);
     wisdom_imported = true;
   }
+  plans_->flags = flags;
+  plans_->measured = planning == FftPlanning::kMeasure;
   const auto start = std::chrono::steady_clock::now();
-  plans_->forward = fftwf_plan_dft_r2c_2d(size, size, image.ptr<float>(),
-                                          reinterpret_cast<fftwf_complex*>(spectrum.data), flags);
-  plans_->inverse = fftwf_plan_dft_c2r_2d(size, size,
-                                          reinterpret_cast<fftwf_complex*>(spectrum.data),
-                                          image.ptr<float>(), flags);
-  if (plans_->forward == nullptr || plans_->inverse == nullptr) {
+  float* padded = reinterpret_cast<float*>(spectrum.data);
+  plans_->forward_in_place = fftwf_plan_dft_r2c_2d(
+      size, size, padded, reinterpret_cast<fftwf_complex*>(spectrum.data), flags);
+  plans_->inverse_in_place = fftwf_plan_dft_c2r_2d(
+      size, size, reinterpret_cast<fftwf_complex*>(spectrum.data), padded, flags);
+  if (plans_->forward_in_place == nullptr || plans_->inverse_in_place == nullptr) {
     throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size) + "^2 FFT");
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
 }
 
+void Fft2d::makeOutOfPlacePlans() const {
+  std::call_once(plans_->out_of_place_made, [this] {
+    cv::Mat1f image(size_, size_);
+    cv::Mat2f spectrum(size_, spectrumCols());
+    std::lock_guard<std::mutex> lock(plannerMutex());
+    const auto start = std::chrono::steady_clock::now();
+    plans_->forward = fftwf_plan_dft_r2c_2d(size_, size_, image.ptr<float>(),
+                                            reinterpret_cast<fftwf_complex*>(spectrum.data),
+                                            plans_->flags);
+    plans_->inverse = fftwf_plan_dft_c2r_2d(size_, size_,
+                                            reinterpret_cast<fftwf_complex*>(spectrum.data),
+                                            image.ptr<float>(), plans_->flags);
+    if (plans_->forward == nullptr || plans_->inverse == nullptr) {
+      throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size_) + "^2 FFT");
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::string wisdom =
+        plans_->measured ? defaultFftWisdomPath() : std::string();
+    if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
+  });
+}
+
 Fft2d::~Fft2d() {
   std::lock_guard<std::mutex> lock(plannerMutex());
-  if (plans_->forward != nullptr) fftwf_destroy_plan(plans_->forward);
-  if (plans_->inverse != nullptr) fftwf_destroy_plan(plans_->inverse);
+  for (fftwf_plan plan : {plans_->forward, plans_->inverse, plans_->forward_in_place,
+                          plans_->inverse_in_place}) {
+    if (plan != nullptr) fftwf_destroy_plan(plan);
+  }
 }
 
 void Fft2d::forward(const cv::Mat1f& image, cv::Mat2f& spectrum) const {
@@ -134,6 +167,7 @@ void Fft2d::forward(const cv::Mat1f& image, cv::Mat2f& spectrum) const {
                      std::to_string(size_) + " float image");
   }
   spectrum.create(size_, spectrumCols());
+  makeOutOfPlacePlans();
   requireAligned(image.data, "input image");
   requireAligned(spectrum.data, "spectrum");
   // r2c out-of-place preserves its input, so dropping const is safe.
@@ -146,10 +180,40 @@ void Fft2d::inverse(cv::Mat2f& spectrum, cv::Mat1f& image) const {
     throw InputError("Fft2d::inverse: spectrum has the wrong shape");
   }
   image.create(size_, size_);
+  makeOutOfPlacePlans();
   requireAligned(image.data, "output image");
   requireAligned(spectrum.data, "spectrum");
   fftwf_execute_dft_c2r(plans_->inverse, reinterpret_cast<fftwf_complex*>(spectrum.data),
                         image.ptr<float>());
+}
+
+void Fft2d::allocateInPlace(cv::Mat2f& buffer) const {
+  buffer.create(size_, spectrumCols());
+}
+
+cv::Mat1f Fft2d::realView(cv::Mat2f& buffer) const {
+  if (buffer.rows != size_ || buffer.cols != spectrumCols() || !buffer.isContinuous()) {
+    throw InputError("Fft2d::realView: not an in-place buffer of size " + std::to_string(size_));
+  }
+  return cv::Mat1f(size_, size_, buffer.ptr<float>(), buffer.step);
+}
+
+void Fft2d::forwardInPlace(cv::Mat2f& buffer) const {
+  if (buffer.rows != size_ || buffer.cols != spectrumCols() || !buffer.isContinuous()) {
+    throw InputError("Fft2d::forwardInPlace: not an in-place buffer of size " + std::to_string(size_));
+  }
+  requireAligned(buffer.data, "in-place buffer");
+  fftwf_execute_dft_r2c(plans_->forward_in_place, buffer.ptr<float>(),
+                        reinterpret_cast<fftwf_complex*>(buffer.data));
+}
+
+void Fft2d::inverseInPlace(cv::Mat2f& buffer) const {
+  if (buffer.rows != size_ || buffer.cols != spectrumCols() || !buffer.isContinuous()) {
+    throw InputError("Fft2d::inverseInPlace: not an in-place buffer of size " + std::to_string(size_));
+  }
+  requireAligned(buffer.data, "in-place buffer");
+  fftwf_execute_dft_c2r(plans_->inverse_in_place, reinterpret_cast<fftwf_complex*>(buffer.data),
+                        buffer.ptr<float>());
 }
 
 }  // namespace oefmt

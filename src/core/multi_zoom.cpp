@@ -64,12 +64,15 @@ MultiZoomTranslation MultiZoomTranslator::analyse(const FrameSpectra& older, con
     if (!(weight > 0.0)) continue;
     const double zoom = std::exp(-(bin - n / 2) * log_zoom_per_bin);
     result.zooms.push_back(zoom);
-    warpSimilarityWindowed(older.grey, rotation_zoom.rotation, zoom, context_->window(), warped_,
+    const Fft2d& fft = context_->fft();
+    fft.allocateInPlace(warped_spectrum_);
+    cv::Mat1f warped = fft.realView(warped_spectrum_);
+    warpSimilarityWindowed(older.grey, rotation_zoom.rotation, zoom, context_->window(), warped,
                            older.mean);
-    context_->fft().forward(warped_, warped_spectrum_);
+    fft.forwardInPlace(warped_spectrum_);
     centredCrossPower(newer.spectrum, warped_spectrum_, cross_power_);
-    context_->fft().inverse(cross_power_, surface_);
-    context_->polarRows(surface_, 0, n, polar_);
+    fft.inverseInPlace(cross_power_);
+    context_->polarRows(fft.realView(cross_power_), 0, n, polar_);
     const float w = static_cast<float>(weight);
     for (int r = 0; r < n; ++r) {
       const float* src = polar_[r];

@@ -137,8 +137,10 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
   centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
   // The full surface: a coarse low-resolution search for the rotation row (to invert only a
   // band of rows) picked wrong rows on simulated flights, where much of the log-polar
-  // correlation's energy sits at high frequencies.
-  context_->fft().inverse(cross_power_, surface_);
+  // correlation's energy sits at high frequencies. In place: the surface is a view of
+  // cross_power_.
+  context_->fft().inverseInPlace(cross_power_);
+  surface_ = context_->fft().realView(cross_power_);
   SurfaceStats stats;
   const SurfacePeak peak = findPeak(surface_, true, &stats, PeakShape::kBroadened);
   const double log_zoom_per_bin = logZoomPerBin();
@@ -167,10 +169,12 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                                       RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
-  cv::Mat1f& warped = warped_;
+  const Fft2d& fft = context_->fft();
+  fft.allocateInPlace(warped_spectrum_);
+  cv::Mat1f warped = fft.realView(warped_spectrum_);
   warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
                          older.mean);
-  context_->fft().forward(warped, warped_spectrum_);
+  fft.forwardInPlace(warped_spectrum_);
 
   if (context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
@@ -186,7 +190,8 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
     }
   }
   centredCrossPower(newer.spectrum, warped_spectrum_, cross_power_, result.half_turn);
-  context_->fft().inverse(cross_power_, surface_);
+  fft.inverseInPlace(cross_power_);
+  surface_ = fft.realView(cross_power_);
   SurfaceStats stats;
   const SurfacePeak peak = findPeak(surface_, true, &stats);
   result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);

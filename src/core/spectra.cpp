@@ -136,13 +136,17 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   frame.texture = image.texture;
   frame.invalid_pixels = image.invalid_pixels;
   frame.mean = static_cast<float>(cv::mean(frame.grey)[0]);
-  context_->window().apply(frame.grey, windowed_, frame.mean);
-  context_->fft().forward(windowed_, frame.spectrum);
+  // Both images are written straight into their spectra's buffers (in-place FFTs).
+  const Fft2d& fft = context_->fft();
+  fft.allocateInPlace(frame.spectrum);
+  cv::Mat1f windowed = fft.realView(frame.spectrum);
+  context_->window().apply(frame.grey, windowed, frame.mean);
+  fft.forwardInPlace(frame.spectrum);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
-  // The apodized image is dead once transformed: its buffer takes the log-polar image.
-  cv::Mat1f& log_polar = windowed_;
+  fft.allocateInPlace(frame.log_polar_spectrum);
+  cv::Mat1f log_polar = fft.realView(frame.log_polar_spectrum);
   context_->logPolar(magnitude_, log_polar);
-  context_->fft().forward(log_polar, frame.log_polar_spectrum);
+  fft.forwardInPlace(frame.log_polar_spectrum);
   return frame;
 }
 

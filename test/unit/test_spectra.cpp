@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "oefmt/error.h"
 #include "oefmt/fft.h"
 #include "oefmt/phase_correlation.h"
 #include "oefmt/spectra.h"
@@ -52,6 +53,29 @@ TEST(Fft, InverseOfForwardReturnsTheImageTimesNSquared) {
   EXPECT_EQ(spectrum.cols, 33);
   fft.inverse(spectrum, back);
   EXPECT_LT(cv::norm(back / (64.0f * 64.0f), image, cv::NORM_INF), 1e-5);
+}
+
+// The in-place transforms (image in the padded rows of the spectrum's buffer) give the same
+// spectrum and image as the out-of-place ones.
+TEST(Fft, InPlaceTransformsMatchOutOfPlace) {
+  const Fft2d fft(64, FftPlanning::kMeasure);
+  cv::Mat1f image(64, 64);
+  cv::randu(image, -1.0f, 1.0f);
+  cv::Mat2f expected;
+  fft.forward(image, expected);
+
+  cv::Mat2f buffer;
+  fft.allocateInPlace(buffer);
+  cv::Mat1f view = fft.realView(buffer);
+  ASSERT_EQ(view.data, buffer.data);
+  image.copyTo(view);
+  fft.forwardInPlace(buffer);
+  EXPECT_LT(cv::norm(buffer, expected, cv::NORM_INF), 1e-4 * cv::norm(expected, cv::NORM_INF));
+
+  fft.inverseInPlace(buffer);
+  EXPECT_LT(cv::norm(fft.realView(buffer) / (64.0f * 64.0f), image, cv::NORM_INF), 1e-5);
+  cv::Mat2f wrong(64, 32);
+  EXPECT_THROW(fft.forwardInPlace(wrong), InputError);
 }
 
 // The fftshift folded into the spectrum must give exactly the shifted, scaled surface, and the
