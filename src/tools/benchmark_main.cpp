@@ -107,26 +107,46 @@ void BM_Stage_FrameSpectra(benchmark::State& state) {
 }
 BENCHMARK(BM_Stage_FrameSpectra)->Unit(benchmark::kMicrosecond);
 
-void BM_Stage_ForwardFft(benchmark::State& state) {
+// As the pipeline runs: the apodized image written into the buffer, then transformed. Argument
+// 0: in place (what runs); 1: into a separate image, transformed out of place.
+void BM_Stage_WindowAndForwardFft(benchmark::State& state) {
+  const oefmt::SpectralContext& context = *inputs().context;
+  const oefmt::Fft2d& fft = context.fft();
   cv::Mat2f spectrum;
+  fft.allocateInPlace(spectrum);
+  cv::Mat1f view = fft.realView(spectrum), separate;
   for (auto _ : state) {
-    inputs().context->fft().forward(inputs().newer.grey, spectrum);
+    if (state.range(0) == 0) {
+      context.window().apply(inputs().newer.grey, view, 0.5f);
+      fft.forwardInPlace(spectrum);
+    } else {
+      context.window().apply(inputs().newer.grey, separate, 0.5f);
+      fft.forward(separate, spectrum);
+    }
     benchmark::ClobberMemory();
   }
 }
-BENCHMARK(BM_Stage_ForwardFft)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_WindowAndForwardFft)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
-void BM_Stage_InverseFft(benchmark::State& state) {
-  cv::Mat2f spectrum, scratch;
+// A cross power, then its inverse transform. Argument 0: in place (what runs); 1: out of place.
+void BM_Stage_CrossPowerAndInverseFft(benchmark::State& state) {
+  const oefmt::Fft2d& fft = inputs().context->fft();
+  oefmt::SpectraBuilder builder(inputs().context);
+  const oefmt::FrameSpectra a = builder.build(inputs().older);
+  const oefmt::FrameSpectra b = builder.build(inputs().newer);
+  cv::Mat2f cross_power;
   cv::Mat1f image;
-  inputs().context->fft().forward(inputs().newer.grey, spectrum);
   for (auto _ : state) {
-    spectrum.copyTo(scratch);
-    inputs().context->fft().inverse(scratch, image);
+    oefmt::centredCrossPower(b.spectrum, a.spectrum, cross_power);
+    if (state.range(0) == 0) {
+      fft.inverseInPlace(cross_power);
+    } else {
+      fft.inverse(cross_power, image);
+    }
     benchmark::ClobberMemory();
   }
 }
-BENCHMARK(BM_Stage_InverseFft)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stage_CrossPowerAndInverseFft)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_Stage_MagnitudeAndLogPolar(benchmark::State& state) {
   cv::Mat2f spectrum;
