@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Hardening checks (issue 6), separate from the main build:
-#   1. the unit tests built with AddressSanitizer + UBSan (catkin build, -DOEFMT_SANITIZE=ON);
-#   2. the libFuzzer targets of fuzz/ (clang++-14), each run for SECONDS on a copy of its seeds.
+# Hardening checks (issue 6), separate from the main build. One clang++-14 build of fuzz/ (the
+# core instrumented with AddressSanitizer + UBSan and libFuzzer's coverage) gives:
+#   1. the unit tests under the sanitizers;
+#   2. the libFuzzer targets, each run for SECONDS on a copy of its seeds.
+# (The catkin build can also be sanitised with gcc: -DOEFMT_SANITIZE=ON.)
 # Usage: bash scripts/hardening.sh BUILD_ROOT [SECONDS]   (SECONDS per fuzz target, default 20)
 # Writes JUnit XML into OEFMT_RESULTS_DIR (default BUILD_ROOT/test_results/oefmt):
 #   sanitizers-oefmt_unit_tests.xml (gtest), sanitizers-exit.xml (only when the run died or
@@ -54,23 +56,33 @@ excerpt() {
 }
 
 # ---------------------------------------------------------------------------------------------
+# 0. One sanitizer build for both checks
+# ---------------------------------------------------------------------------------------------
+fuzz="$root/fuzz"
+fuzz_log="$fuzz/build.log"
+targets=(fuzz_image fuzz_image_pair fuzz_cam_param fuzz_energy_vectors)
+mkdir -p "$fuzz"
+rm -f "$results/sanitizers-oefmt_unit_tests.xml" "$results/sanitizers-exit.xml"
+section "Sanitizer build (clang++-14, ASan+UBSan): oefmt_unit_tests ${targets[*]} in $fuzz"
+built=0
+if cmake -S "$repo/fuzz" -B "$fuzz" -DCMAKE_CXX_COMPILER=clang++-14 >"$fuzz_log" 2>&1 &&
+   cmake --build "$fuzz" -j"$jobs" >>"$fuzz_log" 2>&1; then
+  built=1
+else
+  failed=1
+  tail -n 40 "$fuzz_log"
+  echo "FAILED: sanitizer build (log: $fuzz_log)"
+fi
+echo "(${SECONDS}s elapsed)"
+
+# ---------------------------------------------------------------------------------------------
 # 1. Unit tests under ASan + UBSan
 # ---------------------------------------------------------------------------------------------
-asan="$root/asan"
-asan_log="$asan/hardening.log"
-mkdir -p "$asan"
-rm -f "$results/sanitizers-oefmt_unit_tests.xml" "$results/sanitizers-exit.xml"
-section "ASan+UBSan: configure and build oefmt_unit_tests in $asan"
-# -O1 -g1: quick to build (line tables only), stacks with file:line, fast enough to run. The ROS
-# environment is not needed to configure (Debian's catkin is on the default paths).
-if cmake -S "$repo" -B "$asan" -DOEFMT_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-      -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 >"$asan_log" 2>&1 &&
-   cmake --build "$asan" --target oefmt_unit_tests -j"$jobs" >>"$asan_log" 2>&1; then
+if [ $built = 1 ]; then
   section "ASan+UBSan: run oefmt_unit_tests"
-  binary="$asan/devel/lib/oefmt/oefmt_unit_tests"
+  binary="$fuzz/oefmt_unit_tests"
   xml="$results/sanitizers-oefmt_unit_tests.xml"
-  run_log="$asan/unit_tests.log"
+  run_log="$fuzz/unit_tests.log"
   # In a subshell, so that the shell's own "Aborted" notice goes into the log too.
   (ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     "$binary" --gtest_output="xml:$xml"; exit $?) >"$run_log" 2>&1
@@ -87,24 +99,15 @@ if cmake -S "$repo" -B "$asan" -DOEFMT_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDeb
     echo "ok: oefmt_unit_tests under ASan+UBSan"
   fi
 else
-  failed=1
-  tail -n 40 "$asan_log"
-  junit "$results/sanitizers-exit.xml" Sanitizers build "sanitizer build failed" "$asan_log"
-  echo "FAILED: sanitizer build (log: $asan_log)"
+  junit "$results/sanitizers-exit.xml" Sanitizers build "sanitizer build failed" "$fuzz_log"
 fi
 echo "(${SECONDS}s elapsed)"
 
 # ---------------------------------------------------------------------------------------------
 # 2. libFuzzer targets
 # ---------------------------------------------------------------------------------------------
-fuzz="$root/fuzz"
-fuzz_log="$fuzz/build.log"
-targets=(fuzz_image fuzz_image_pair fuzz_cam_param fuzz_energy_vectors)
-mkdir -p "$fuzz"
-section "Fuzz: build ${targets[*]} with clang++-14 in $fuzz"
 cases=()
-if cmake -S "$repo/fuzz" -B "$fuzz" -DCMAKE_CXX_COMPILER=clang++-14 >"$fuzz_log" 2>&1 &&
-   cmake --build "$fuzz" -j"$jobs" >>"$fuzz_log" 2>&1; then
+if [ $built = 1 ]; then
   section "Fuzz: ${seconds}s per target, up to $jobs at a time"
   # Fork mode: a timeout does not end the run; each one is replayed afterwards, and one that
   # hangs again fails (parameter files no longer go through OpenCV's YAML reader, which looped
@@ -164,10 +167,7 @@ if cmake -S "$repo/fuzz" -B "$fuzz" -DCMAKE_CXX_COMPILER=clang++-14 >"$fuzz_log"
     fi
   done
 else
-  failed=1
-  tail -n 40 "$fuzz_log"
-  echo "FAILED: fuzz build (log: $fuzz_log)"
-  for target in "${targets[@]}"; do cases+=("$target" "fuzz build failed" "$fuzz_log"); done
+  for target in "${targets[@]}"; do cases+=("$target" "sanitizer build failed" "$fuzz_log"); done
 fi
 junit "$results/fuzz.xml" Fuzz "${cases[@]}"
 
