@@ -48,6 +48,7 @@ class Fft2d {
 
  private:
   void makeOutOfPlacePlans() const;
+  void requireInPlaceBuffer(const cv::Mat2f& buffer, const char* what) const;
 
   struct Plans;
   int size_;

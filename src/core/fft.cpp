@@ -59,6 +59,20 @@ bool exportWisdomLocked(const std::string& path) {
   return !error;
 }
 
+// Plans the r2c and c2r transforms between `real` and `complex` (the same memory: in place) and
+// saves the wisdom when it had to be measured. The caller holds the planner mutex.
+void planPairLocked(int size, float* real, fftwf_complex* complex, unsigned flags,
+                    const std::string& wisdom, fftwf_plan& forward, fftwf_plan& inverse) {
+  const auto start = std::chrono::steady_clock::now();
+  forward = fftwf_plan_dft_r2c_2d(size, size, real, complex, flags);
+  inverse = fftwf_plan_dft_c2r_2d(size, size, complex, real, flags);
+  if (forward == nullptr || inverse == nullptr) {
+    throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size) + "^2 FFT");
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
+}
+
 }  // namespace
 
 std::string defaultFftWisdomPath() {
@@ -117,17 +131,9 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
   }
   plans_->flags = flags;
   plans_->measured = planning == FftPlanning::kMeasure;
-  const auto start = std::chrono::steady_clock::now();
-  float* padded = reinterpret_cast<float*>(spectrum.data);
-  plans_->forward_in_place = fftwf_plan_dft_r2c_2d(
-      size, size, padded, reinterpret_cast<fftwf_complex*>(spectrum.data), flags);
-  plans_->inverse_in_place = fftwf_plan_dft_c2r_2d(
-      size, size, reinterpret_cast<fftwf_complex*>(spectrum.data), padded, flags);
-  if (plans_->forward_in_place == nullptr || plans_->inverse_in_place == nullptr) {
-    throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size) + "^2 FFT");
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
+  planPairLocked(size, reinterpret_cast<float*>(spectrum.data),
+                 reinterpret_cast<fftwf_complex*>(spectrum.data), flags, wisdom,
+                 plans_->forward_in_place, plans_->inverse_in_place);
 }
 
 void Fft2d::makeOutOfPlacePlans() const {
@@ -135,21 +141,9 @@ void Fft2d::makeOutOfPlacePlans() const {
     cv::Mat1f image(size_, size_);
     cv::Mat2f spectrum(size_, spectrumCols());
     std::lock_guard<std::mutex> lock(plannerMutex());
-    const auto start = std::chrono::steady_clock::now();
-    plans_->forward = fftwf_plan_dft_r2c_2d(size_, size_, image.ptr<float>(),
-                                            reinterpret_cast<fftwf_complex*>(spectrum.data),
-                                            plans_->flags);
-    plans_->inverse = fftwf_plan_dft_c2r_2d(size_, size_,
-                                            reinterpret_cast<fftwf_complex*>(spectrum.data),
-                                            image.ptr<float>(), plans_->flags);
-    if (plans_->forward == nullptr || plans_->inverse == nullptr) {
-      throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size_) + "^2 FFT");
-    }
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::string wisdom =
-        plans_->measured ? defaultFftWisdomPath() : std::string();
-    if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
+    planPairLocked(size_, image.ptr<float>(), reinterpret_cast<fftwf_complex*>(spectrum.data),
+                   plans_->flags, plans_->measured ? defaultFftWisdomPath() : std::string(),
+                   plans_->forward, plans_->inverse);
   });
 }
 
@@ -191,27 +185,27 @@ void Fft2d::allocateInPlace(cv::Mat2f& buffer) const {
   buffer.create(size_, spectrumCols());
 }
 
-cv::Mat1f Fft2d::realView(cv::Mat2f& buffer) const {
+void Fft2d::requireInPlaceBuffer(const cv::Mat2f& buffer, const char* what) const {
   if (buffer.rows != size_ || buffer.cols != spectrumCols() || !buffer.isContinuous()) {
-    throw InputError("Fft2d::realView: not an in-place buffer of size " + std::to_string(size_));
+    throw InputError(std::string("Fft2d::") + what + ": not an in-place buffer of size " +
+                     std::to_string(size_));
   }
+  requireAligned(buffer.data, what);
+}
+
+cv::Mat1f Fft2d::realView(cv::Mat2f& buffer) const {
+  requireInPlaceBuffer(buffer, "realView");
   return cv::Mat1f(size_, size_, buffer.ptr<float>(), buffer.step);
 }
 
 void Fft2d::forwardInPlace(cv::Mat2f& buffer) const {
-  if (buffer.rows != size_ || buffer.cols != spectrumCols() || !buffer.isContinuous()) {
-    throw InputError("Fft2d::forwardInPlace: not an in-place buffer of size " + std::to_string(size_));
-  }
-  requireAligned(buffer.data, "in-place buffer");
+  requireInPlaceBuffer(buffer, "forwardInPlace");
   fftwf_execute_dft_r2c(plans_->forward_in_place, buffer.ptr<float>(),
                         reinterpret_cast<fftwf_complex*>(buffer.data));
 }
 
 void Fft2d::inverseInPlace(cv::Mat2f& buffer) const {
-  if (buffer.rows != size_ || buffer.cols != spectrumCols() || !buffer.isContinuous()) {
-    throw InputError("Fft2d::inverseInPlace: not an in-place buffer of size " + std::to_string(size_));
-  }
-  requireAligned(buffer.data, "in-place buffer");
+  requireInPlaceBuffer(buffer, "inverseInPlace");
   fftwf_execute_dft_c2r(plans_->inverse_in_place, reinterpret_cast<fftwf_complex*>(buffer.data),
                         buffer.ptr<float>());
 }
