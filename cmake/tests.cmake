@@ -2,10 +2,11 @@
 # Tests that need ROS (bags) or the built tools; the ROS-free unit tests are globbed from
 # test/unit into oefmt_unit_tests by CMakeLists.txt.
 
-catkin_add_gtest(oefmt_io_tests test/io/test_bag_io.cpp test/io/test_tools.cpp test/support/gtest_main.cpp)
+catkin_add_gtest(oefmt_io_tests test/io/test_bag_io.cpp test/io/test_tools.cpp
+                 test/io/test_debug_rendering.cpp test/support/gtest_main.cpp)
 if(TARGET oefmt_io_tests)
   target_include_directories(oefmt_io_tests PRIVATE test)
-  target_link_libraries(oefmt_io_tests oefmt_bag_io oefmt_sim oefmt_core)
+  target_link_libraries(oefmt_io_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_core)
   target_compile_definitions(oefmt_io_tests PRIVATE
     OEFMT_SIMULATE="$<TARGET_FILE:oefmt_simulate>"
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"

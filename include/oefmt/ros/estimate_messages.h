@@ -37,7 +37,8 @@ oefmt::EnergyVectors energyVectorsMessage(const Estimate& estimate, double log_z
 /// matching factors, for rviz's Image display.
 cv::Mat renderEnergyVectors(const Estimate& estimate, double shift_per_bin, cv::Size size = {800, 500});
 
-/// A correlation surface as a BGR heat map (|v|, cube-root scaled so that weak peaks show).
+/// A correlation surface as a BGR heat map: inferno colour of cbrt(|v| / max|v|) (cube-root
+/// scaled so that weak peaks show; 0 is black). NaN pixels take the top colour.
 cv::Mat renderSurface(const cv::Mat1f& surface);
 
 }  // namespace oefmt
