@@ -59,20 +59,6 @@ bool exportWisdomLocked(const std::string& path) {
   return !error;
 }
 
-// Plans the r2c and c2r transforms between `real` and `complex` (the same memory: in place) and
-// saves the wisdom when it had to be measured. The caller holds the planner mutex.
-void planPairLocked(int size, float* real, fftwf_complex* complex, unsigned flags,
-                    const std::string& wisdom, fftwf_plan& forward, fftwf_plan& inverse) {
-  const auto start = std::chrono::steady_clock::now();
-  forward = fftwf_plan_dft_r2c_2d(size, size, real, complex, flags);
-  inverse = fftwf_plan_dft_c2r_2d(size, size, complex, real, flags);
-  if (forward == nullptr || inverse == nullptr) {
-    throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size) + "^2 FFT");
-  }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
-}
-
 }  // namespace
 
 std::string defaultFftWisdomPath() {
@@ -94,6 +80,27 @@ std::string defaultFftWisdomPath() {
   return (cache / "oefmt" / (std::string("fftwf-wisdom-") + host)).string();
 }
 
+namespace {
+
+// Plans the r2c and c2r transforms between `real` and `complex` (the same memory: in place) and
+// saves the wisdom when it had to be measured. The caller holds the planner mutex.
+void planPairLocked(int size, float* real, fftwf_complex* complex, FftPlanning planning,
+                    fftwf_plan& forward, fftwf_plan& inverse) {
+  const bool measure = planning == FftPlanning::kMeasure;
+  const unsigned flags = measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+  const std::string wisdom = measure ? defaultFftWisdomPath() : std::string();
+  const auto start = std::chrono::steady_clock::now();
+  forward = fftwf_plan_dft_r2c_2d(size, size, real, complex, flags);
+  inverse = fftwf_plan_dft_c2r_2d(size, size, complex, real, flags);
+  if (forward == nullptr || inverse == nullptr) {
+    throw std::runtime_error("Fft2d: FFTW could not plan a " + std::to_string(size) + "^2 FFT");
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!wisdom.empty() && seconds > kNewWisdomSeconds) exportWisdomLocked(wisdom);
+}
+
+}  // namespace
+
 bool importFftWisdom(const std::string& path) {
   std::lock_guard<std::mutex> lock(plannerMutex());
   return importWisdomLocked(path);
@@ -112,15 +119,13 @@ struct Fft2d::Plans {
   std::once_flag out_of_place_made;
   fftwf_plan forward = nullptr;
   fftwf_plan inverse = nullptr;
-  unsigned flags = 0;
-  bool measured = false;  // FFTW_MEASURE is 0: remember whether wisdom applies
+  FftPlanning planning = FftPlanning::kMeasure;
 };
 
 Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_unique<Plans>()) {
   if (size < 2 || size % 2 != 0) {
     throw InputError("Fft2d: size must be even and >= 2, got " + std::to_string(size));
   }
-  const unsigned flags = planning == FftPlanning::kMeasure ? FFTW_MEASURE : FFTW_ESTIMATE;
   cv::Mat2f spectrum(size, spectrumCols());
   std::lock_guard<std::mutex> lock(plannerMutex());
   static bool wisdom_imported = false;  // guarded by the planner mutex
@@ -129,10 +134,9 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
     importWisdomLocked(wisdom);
     wisdom_imported = true;
   }
-  plans_->flags = flags;
-  plans_->measured = planning == FftPlanning::kMeasure;
+  plans_->planning = planning;
   planPairLocked(size, reinterpret_cast<float*>(spectrum.data),
-                 reinterpret_cast<fftwf_complex*>(spectrum.data), flags, wisdom,
+                 reinterpret_cast<fftwf_complex*>(spectrum.data), planning,
                  plans_->forward_in_place, plans_->inverse_in_place);
 }
 
@@ -142,8 +146,7 @@ void Fft2d::makeOutOfPlacePlans() const {
     cv::Mat2f spectrum(size_, spectrumCols());
     std::lock_guard<std::mutex> lock(plannerMutex());
     planPairLocked(size_, image.ptr<float>(), reinterpret_cast<fftwf_complex*>(spectrum.data),
-                   plans_->flags, plans_->measured ? defaultFftWisdomPath() : std::string(),
-                   plans_->forward, plans_->inverse);
+                   plans_->planning, plans_->forward, plans_->inverse);
   });
 }
 
@@ -181,8 +184,9 @@ void Fft2d::inverse(cv::Mat2f& spectrum, cv::Mat1f& image) const {
                         image.ptr<float>());
 }
 
-void Fft2d::allocateInPlace(cv::Mat2f& buffer) const {
+cv::Mat1f Fft2d::inPlaceInput(cv::Mat2f& buffer) const {
   buffer.create(size_, spectrumCols());
+  return realView(buffer);
 }
 
 void Fft2d::requireInPlaceBuffer(const cv::Mat2f& buffer, const char* what) const {

@@ -65,8 +65,7 @@ MultiZoomTranslation MultiZoomTranslator::analyse(const FrameSpectra& older, con
     const double zoom = std::exp(-(bin - n / 2) * log_zoom_per_bin);
     result.zooms.push_back(zoom);
     const Fft2d& fft = context_->fft();
-    fft.allocateInPlace(warped_spectrum_);
-    cv::Mat1f warped = fft.realView(warped_spectrum_);
+    cv::Mat1f warped = fft.inPlaceInput(warped_spectrum_);
     warpSimilarityWindowed(older.grey, rotation_zoom.rotation, zoom, context_->window(), warped,
                            older.mean);
     fft.forwardInPlace(warped_spectrum_);

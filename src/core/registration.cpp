@@ -170,8 +170,7 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
   const Fft2d& fft = context_->fft();
-  fft.allocateInPlace(warped_spectrum_);
-  cv::Mat1f warped = fft.realView(warped_spectrum_);
+  cv::Mat1f warped = fft.inPlaceInput(warped_spectrum_);
   warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
                          older.mean);
   fft.forwardInPlace(warped_spectrum_);

@@ -138,13 +138,11 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   frame.mean = static_cast<float>(cv::mean(frame.grey)[0]);
   // Both images are written straight into their spectra's buffers (in-place FFTs).
   const Fft2d& fft = context_->fft();
-  fft.allocateInPlace(frame.spectrum);
-  cv::Mat1f windowed = fft.realView(frame.spectrum);
+  cv::Mat1f windowed = fft.inPlaceInput(frame.spectrum);
   context_->window().apply(frame.grey, windowed, frame.mean);
   fft.forwardInPlace(frame.spectrum);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
-  fft.allocateInPlace(frame.log_polar_spectrum);
-  cv::Mat1f log_polar = fft.realView(frame.log_polar_spectrum);
+  cv::Mat1f log_polar = fft.inPlaceInput(frame.log_polar_spectrum);
   context_->logPolar(magnitude_, log_polar);
   fft.forwardInPlace(frame.log_polar_spectrum);
   return frame;

@@ -113,8 +113,7 @@ void BM_Stage_WindowAndForwardFft(benchmark::State& state) {
   const oefmt::SpectralContext& context = *inputs().context;
   const oefmt::Fft2d& fft = context.fft();
   cv::Mat2f spectrum;
-  fft.allocateInPlace(spectrum);
-  cv::Mat1f view = fft.realView(spectrum), separate;
+  cv::Mat1f view = fft.inPlaceInput(spectrum), separate;
   for (auto _ : state) {
     if (state.range(0) == 0) {
       context.window().apply(inputs().newer.grey, view, 0.5f);

@@ -65,8 +65,7 @@ TEST(Fft, InPlaceTransformsMatchOutOfPlace) {
   fft.forward(image, expected);
 
   cv::Mat2f buffer;
-  fft.allocateInPlace(buffer);
-  cv::Mat1f view = fft.realView(buffer);
+  cv::Mat1f view = fft.inPlaceInput(buffer);
   ASSERT_EQ(view.data, buffer.data);
   image.copyTo(view);
   fft.forwardInPlace(buffer);
