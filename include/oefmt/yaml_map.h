@@ -5,6 +5,7 @@
 // pass over the lines and refuses, with the line number, whatever it does not take.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,6 +23,10 @@ struct YamlNode {
   /// The child named `key`, or nullptr.
   const YamlNode* find(const std::string& key) const;
 };
+
+/// A scalar's text as a number: strtod must read all of it (leading blanks aside). nullopt for
+/// empty or partly numeric text; `out_of_range` (when given) tells whether strtod reported ERANGE.
+std::optional<double> yamlNumber(const std::string& text, bool* out_of_range = nullptr);
 
 /// Parses block maps of scalars: "key: value" lines nested by indentation (spaces), plain or
 /// quoted ('...' or "...") keys and values, "#" comments, leading "%" directives and a "---"

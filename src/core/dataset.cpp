@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -55,14 +54,10 @@ double readNumber(const YamlNode& root, const std::string& path, const char* key
     if (required) throw DatasetError("'" + path + "' has no Camera." + key);
     return fallback;
   }
-  const std::string& text = node->scalar;
-  char* end = nullptr;
-  const double value = node->is_map ? 0.0 : std::strtod(text.c_str(), &end);
-  if (node->is_map || text.empty() || end != text.c_str() + text.size()) {
-    throw DatasetError("'" + path + "': Camera." + key + " is not a number");
-  }
-  if (!std::isfinite(value)) throw DatasetError("'" + path + "': Camera." + key + " is not finite");
-  return value;
+  const std::optional<double> value = node->is_map ? std::nullopt : yamlNumber(node->scalar);
+  if (!value) throw DatasetError("'" + path + "': Camera." + key + " is not a number");
+  if (!std::isfinite(*value)) throw DatasetError("'" + path + "': Camera." + key + " is not finite");
+  return *value;
 }
 
 bool isImageFile(const fs::path& path) {

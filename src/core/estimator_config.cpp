@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/estimator_config.h"
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -44,12 +42,10 @@ const std::string& scalarOf(const YamlNode& node, const std::string& key, const 
 }
 
 double readDouble(const YamlNode& node, const std::string& key) {
-  const std::string text = trimmed(scalarOf(node, key, "a number"));
-  char* end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno != 0) badValue(key, "a number");
-  return v;
+  bool out_of_range = false;
+  const std::optional<double> v = yamlNumber(trimmed(scalarOf(node, key, "a number")), &out_of_range);
+  if (!v || out_of_range) badValue(key, "a number");
+  return *v;
 }
 
 int readInt(const YamlNode& node, const std::string& key) {

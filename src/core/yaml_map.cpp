@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/yaml_map.h"
 
+#include <cerrno>
 #include <cstddef>
+#include <cstdlib>
 
 #include "oefmt/error.h"
 #include "oefmt/yaml_text.h"
@@ -193,6 +195,15 @@ const YamlNode* YamlNode::find(const std::string& key) const {
     if (name == key) return &node;
   }
   return nullptr;
+}
+
+std::optional<double> yamlNumber(const std::string& text, bool* out_of_range) {
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  if (out_of_range != nullptr) *out_of_range = errno == ERANGE;
+  if (text.empty() || end != text.c_str() + text.size()) return std::nullopt;
+  return value;
 }
 
 YamlNode parseYaml(const std::string& text, const std::string& what) {
