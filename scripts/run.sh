@@ -66,8 +66,8 @@ run_tests() {
   ros_environment
   rm -rf "$build/test_results"
   cmake --build "$build" --target run_tests -j1 || true  # always exits 0; judged below
-  # Unit tests under ASan+UBSan and every libFuzzer target for 20 s (separate builds in
-  # $build/hardening); their JUnit files join the others, so the summary judges them too.
+  # Unit tests under ASan+UBSan and every libFuzzer target for 20 s (one separate clang build
+  # in $build/hardening); their JUnit files join the others, so the summary judges them too.
   OEFMT_RESULTS_DIR="$build/test_results/oefmt" bash "$repo/scripts/hardening.sh" "$build/hardening" 20 || true
   # Show catkin's own view of failures, then count cases (catkin double-counts gtest cases).
   catkin_test_results "$build/test_results" 2>&1 | grep -E -v "^(Skipping|Summary)" || true

@@ -30,12 +30,11 @@ inline std::vector<double> numberList(const std::string& option, const std::stri
   std::stringstream stream(text);
   std::string item;
   while (std::getline(stream, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) {
+    try {
+      values.push_back(toNumber(option, item));
+    } catch (const InputError&) {  // name the whole list, not the item
       throw InputError("option " + option + " needs numbers separated by commas, got '" + text + "'");
     }
-    values.push_back(v);
   }
   return values;
 }
