@@ -146,6 +146,10 @@ TEST(Dataset, ClearErrorsForMissingOrBrokenFiles) {
   expectDatasetError([&] { FolderDataset(dir.path().string()); }, "Camera.fx");
   writeText(dir / "cam_param.yaml", "Camera.fx: [1, \n");
   expectDatasetError([&] { FolderDataset(dir.path().string()); }, "cam_param.yaml', line 1");
+  writeText(dir / "cam_param.yaml", "Camera.fx: 400px\nCamera.fy: 1\nCamera.cx: 1\nCamera.cy: 1\n");
+  expectDatasetError([&] { FolderDataset(dir.path().string()); }, "Camera.fx is not a number");
+  writeText(dir / "cam_param.yaml", "Camera.fx: 1e400\nCamera.fy: 1\nCamera.cx: 1\nCamera.cy: 1\n");
+  expectDatasetError([&] { FolderDataset(dir.path().string()); }, "Camera.fx is not finite");
 }
 
 TEST(Dataset, CameraParametersRoundTrip) {

@@ -114,6 +114,10 @@ TEST(EstimatorConfig, ErrorsNameTheKey) {
             std::string::npos);
   EXPECT_NE(errorOf("%YAML:1.0\nmatching:\n  shift_step: abc\n").find("matching.shift_step"),
             std::string::npos);
+  // A number with a unit after it, and one beyond float range (strtod: ERANGE).
+  EXPECT_NE(errorOf("%YAML:1.0\naltitude: 12m\n").find("'altitude'"), std::string::npos);
+  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  min_texture: 1e-400\n").find("registration.min_texture"),
+            std::string::npos);
 }
 
 TEST(EstimatorConfig, UnreadableFilesAreInputErrors) {

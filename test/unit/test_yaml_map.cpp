@@ -20,6 +20,22 @@ std::string errorOf(const std::string& text) {
   return "accepted";
 }
 
+// Scalars are numbers only when strtod reads all of the text.
+TEST(YamlMap, ScalarsAsNumbers) {
+  EXPECT_EQ(yamlNumber("512"), 512.0);
+  EXPECT_EQ(yamlNumber("-1.5e-3"), -1.5e-3);
+  EXPECT_EQ(yamlNumber(" 7"), 7.0);  // leading blanks, as strtod
+  EXPECT_FALSE(yamlNumber(""));
+  EXPECT_FALSE(yamlNumber("12m"));
+  EXPECT_FALSE(yamlNumber("7 "));
+  EXPECT_FALSE(yamlNumber("abc"));
+  bool out_of_range = false;
+  EXPECT_TRUE(yamlNumber("1e-400", &out_of_range));
+  EXPECT_TRUE(out_of_range);
+  EXPECT_TRUE(yamlNumber("0.25", &out_of_range));
+  EXPECT_FALSE(out_of_range);
+}
+
 TEST(YamlMap, NestedMapsScalarsCommentsAndQuotes) {
   const YamlNode root = parseYaml(
       "%YAML 1.0\n---\n# a comment\nmode: oefmt   # trailing comment\n"
