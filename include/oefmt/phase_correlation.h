@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "oefmt/fft.h"
+#include "oefmt/simd_kernel.h"
 
 namespace oefmt {
 
@@ -13,13 +14,13 @@ namespace oefmt {
 /// With half_turn, older is taken turned by 180 degrees about the centre, whose spectrum is
 /// conj(older) for a real image: out = newer * older / |newer * older|.
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
-                          bool half_turn = false);
+                          bool half_turn = false, SimdKernel kernel = SimdKernel::kAuto);
 
 /// The same cross power, modulated so that its inverse FFT (Fft2d::inverse) is directly the
 /// centred surface fftshift(correlation) / N^2, where a shift t peaks at (N/2, N/2) + t:
 /// fftshift and 1/N^2 are folded into the spectrum as (-1)^(fx + fy) / N^2 (no extra pass).
 void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
-                       bool half_turn = false);
+                       bool half_turn = false, SimdKernel kernel = SimdKernel::kAuto);
 
 /// Height of the phase-correlation peak computed from the lowest frequencies only (an M x M
 /// correlation with M = small.size()): a cheap test of which of two hypotheses matches.

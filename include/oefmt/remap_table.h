@@ -9,6 +9,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/simd_kernel.h"
+
 namespace oefmt {
 
 class BilinearRemapTable {
@@ -23,13 +25,15 @@ class BilinearRemapTable {
   cv::Size sourceSize() const { return source_; }
 
   /// out (output size) = source resampled.
-  void apply(const cv::Mat1f& source, cv::Mat1f& out) const;
+  void apply(const cv::Mat1f& source, cv::Mat1f& out,
+             SimdKernel kernel = SimdKernel::kAuto) const;
   /// out (count x output width) = output rows first_row .. first_row + count - 1, taken
   /// cyclically (row indices wrap around the output height).
-  void applyRows(const cv::Mat1f& source, int first_row, int count, cv::Mat1f& out) const;
+  void applyRows(const cv::Mat1f& source, int first_row, int count, cv::Mat1f& out,
+                 SimdKernel kernel = SimdKernel::kAuto) const;
 
  private:
-  void applyRow(const float* source, int row, float* out) const;
+  void applyRow(const float* source, int row, float* out, bool avx2) const;
 
   cv::Size output_;
   cv::Size source_;

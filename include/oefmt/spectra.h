@@ -88,6 +88,7 @@ class SpectraBuilder {
 /// Writes rows 0 .. N/2 + 1 of the centred N x N image |spectrum| * filter (DC at (N/2, N/2)):
 /// the half plane the log-polar transform samples (the magnitude is point-symmetric), filling
 /// the columns the real FFT omits by Hermitian symmetry. `filter` holds (at least) those rows.
-void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude);
+void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude,
+                        SimdKernel kernel = SimdKernel::kAuto);
 
 }  // namespace oefmt

@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/simd_kernel.h"
 #include "oefmt/window.h"
 
 namespace oefmt {
@@ -12,11 +13,8 @@ namespace oefmt {
 /// inside the source and 0 outside: source rotated counter-clockwise on screen by `rotation`
 /// [rad] and zoomed by `zoom` about centre = (N/2, N/2), less its mean `offset`, then apodized.
 /// One pass, no intermediate image.
-/// kAuto uses an AVX2 + FMA kernel when the CPU has both (the same result up to float rounding),
-/// kPortable the SSE code every x86-64-v2 CPU runs (for comparisons and benchmarks).
-enum class WarpKernel { kAuto, kPortable };
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
                             const SeparableWindow& window, cv::Mat1f& out, float offset = 0.0f,
-                            WarpKernel kernel = WarpKernel::kAuto);
+                            SimdKernel kernel = SimdKernel::kAuto);
 
 }  // namespace oefmt

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "oefmt/error.h"
+#include "simd_kernels.h"
 
 namespace oefmt {
 namespace {
@@ -21,9 +22,13 @@ int wrap(int i, int n) { return ((i % n) + n) % n; }
 
 // Normalised cross power of `count` interleaved complex values, element i multiplied by
 // `factor` * (-1)^i when `alternate`; the loop has no branch and no call, so the compiler
-// vectorises it.
+// vectorises it (the AVX2 kernel computes the same).
 void crossPowerRun(const float* p, const float* q, float* out, int count, float conjugate_sign,
-                   float factor = 1.0f, bool alternate = false) {
+                   float factor, bool alternate, SimdKernel kernel) {
+  if (kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels()) {
+    detail::crossPowerRowAvx2(p, q, out, count, conjugate_sign, factor, alternate);
+    return;
+  }
   const float odd_factor = alternate ? -factor : factor;
 #pragma omp simd
   for (int i = 0; i < count; ++i) {
@@ -69,16 +74,16 @@ double widenedPeakOffset(float left, float centre, float right) {
 }  // namespace
 
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
-                          bool half_turn) {
+                          bool half_turn, SimdKernel kernel) {
   requireSameShape(newer, older);
   out.create(newer.size());
   // older * conj -> p * conj(q); half turn: p * q (conj(conj(q))).
   crossPowerRun(newer.ptr<float>(), older.ptr<float>(), out.ptr<float>(),
-                static_cast<int>(newer.total()), half_turn ? -1.0f : 1.0f);
+                static_cast<int>(newer.total()), half_turn ? -1.0f : 1.0f, 1.0f, false, kernel);
 }
 
 void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
-                       bool half_turn) {
+                       bool half_turn, SimdKernel kernel) {
   requireSameShape(newer, older);
   out.create(newer.size());
   const int n = newer.rows;
@@ -87,7 +92,7 @@ void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f
   const float scale = 1.0f / (static_cast<float>(n) * static_cast<float>(n));
   for (int row = 0; row < n; ++row) {
     crossPowerRun(newer.ptr<float>(row), older.ptr<float>(row), out.ptr<float>(row), newer.cols,
-                  half_turn ? -1.0f : 1.0f, (row & 1) ? -scale : scale, true);
+                  half_turn ? -1.0f : 1.0f, (row & 1) ? -scale : scale, true, kernel);
   }
 }
 
@@ -103,7 +108,8 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
     const int fy = i < m / 2 ? i : i - m;
     const int big_row = wrap(fy, n);
     crossPowerRun(newer.ptr<float>(big_row), older.ptr<float>(big_row),
-                  scratch_spectrum.ptr<float>(i), small.spectrumCols(), half_turn ? -1.0f : 1.0f);
+                  scratch_spectrum.ptr<float>(i), small.spectrumCols(), half_turn ? -1.0f : 1.0f,
+                  1.0f, false, SimdKernel::kAuto);
   }
   small.inverse(scratch_spectrum, scratch_surface);
   double min_value = 0.0, max_value = 0.0;

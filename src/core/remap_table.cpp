@@ -7,6 +7,7 @@
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "oefmt/error.h"
+#include "simd_kernels.h"
 
 namespace oefmt {
 
@@ -37,7 +38,7 @@ BilinearRemapTable::BilinearRemapTable(cv::Size output, cv::Size source,
   }
 }
 
-void BilinearRemapTable::applyRow(const float* source, int row, float* out) const {
+void BilinearRemapTable::applyRow(const float* source, int row, float* out, bool avx2) const {
   const size_t first = static_cast<size_t>(row) * output_.width;
   const std::int32_t* offset = offset_.data() + first;
   const float* w0 = weight_[0].data() + first;
@@ -45,6 +46,10 @@ void BilinearRemapTable::applyRow(const float* source, int row, float* out) cons
   const float* w2 = weight_[2].data() + first;
   const float* w3 = weight_[3].data() + first;
   const int stride = source_.width;
+  if (avx2) {
+    detail::remapRowAvx2({source, stride, offset, {w0, w1, w2, w3}, output_.width, out});
+    return;
+  }
   int c = 0;
 #if CV_SIMD128
   for (; c + 4 <= output_.width; c += 4) {
@@ -62,20 +67,21 @@ void BilinearRemapTable::applyRow(const float* source, int row, float* out) cons
   }
 }
 
-void BilinearRemapTable::apply(const cv::Mat1f& source, cv::Mat1f& out) const {
-  applyRows(source, 0, output_.height, out);
+void BilinearRemapTable::apply(const cv::Mat1f& source, cv::Mat1f& out, SimdKernel kernel) const {
+  applyRows(source, 0, output_.height, out, kernel);
 }
 
 void BilinearRemapTable::applyRows(const cv::Mat1f& source, int first_row, int count,
-                                   cv::Mat1f& out) const {
+                                   cv::Mat1f& out, SimdKernel kernel) const {
   if (source.size() != source_ || !source.isContinuous()) {
     throw InputError("remap table: source must be a continuous " + std::to_string(source_.width) +
                      "x" + std::to_string(source_.height) + " image");
   }
   out.create(count, output_.width);
+  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
   for (int i = 0; i < count; ++i) {
     const int row = ((first_row + i) % output_.height + output_.height) % output_.height;
-    applyRow(source.ptr<float>(), row, out[i]);
+    applyRow(source.ptr<float>(), row, out[i], avx2);
   }
 }
 

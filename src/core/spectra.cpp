@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
+#include "simd_kernels.h"
 
 namespace oefmt {
 namespace {
@@ -85,26 +86,35 @@ void SpectralContext::polarRows(const cv::Mat1f& centred_surface, int first_row,
   }
 }
 
-void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude) {
+void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude,
+                        SimdKernel kernel) {
   const int n = spectrum.rows;
   const int half = n / 2;
   magnitude.create(half + 2, n);
+  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+  // |.| of the half + 1 stored columns of the two spectrum rows a centred row needs.
+  std::vector<float> direct(half + 1), mirror(half + 1);
+  auto magnitudes = [avx2](const float* complex_values, int count, float* out) {
+    if (avx2) {
+      detail::magnitudeRowAvx2(complex_values, count, out);
+      return;
+    }
+#pragma omp simd
+    for (int i = 0; i < count; ++i) {
+      const float re = complex_values[2 * i], im = complex_values[2 * i + 1];
+      out[i] = std::sqrt(re * re + im * im);
+    }
+  };
   for (int row = 0; row < half + 2; ++row) {
     // Centred row `row` holds frequency fy = row - N/2; columns with fx >= 0 come from spectrum
     // row fy mod N, columns with fx < 0 from the conjugate at (-fx, -fy).
     const int fy = row - half;
-    const Complex* direct = reinterpret_cast<const Complex*>(spectrum.ptr(((fy % n) + n) % n));
-    const Complex* mirror = reinterpret_cast<const Complex*>(spectrum.ptr(((-fy % n) + n) % n));
+    magnitudes(spectrum.ptr<float>(((fy % n) + n) % n), half + 1, direct.data());
+    magnitudes(spectrum.ptr<float>(((-fy % n) + n) % n), half + 1, mirror.data());
     const float* h = filter[row];
     float* out = magnitude[row];
-    for (int col = half; col < n; ++col) {
-      const Complex v = direct[col - half];
-      out[col] = std::sqrt(v.real() * v.real() + v.imag() * v.imag()) * h[col];
-    }
-    for (int col = 0; col < half; ++col) {
-      const Complex v = mirror[half - col];
-      out[col] = std::sqrt(v.real() * v.real() + v.imag() * v.imag()) * h[col];
-    }
+    for (int col = half; col < n; ++col) out[col] = direct[col - half] * h[col];
+    for (int col = 0; col < half; ++col) out[col] = mirror[half - col] * h[col];
   }
 }
 

@@ -7,23 +7,14 @@
 
 #include "oefmt/error.h"
 #include "bilinear_sample.h"
-#include "warp_kernels.h"
+#include "simd_kernels.h"
 
 namespace oefmt {
-namespace detail {
-
-bool cpuHasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
-
-}  // namespace detail
-
 using detail::sampleBilinear;
 
 void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoom,
                             const SeparableWindow& window, cv::Mat1f& out, float offset,
-                            WarpKernel kernel) {
+                            SimdKernel kernel) {
   if (source.empty() || source.rows != window.size() || source.cols != window.size() ||
       !(zoom > 0.0) || !source.isContinuous()) {
     throw InputError("warpSimilarityWindowed: bad source, window or zoom");
@@ -38,7 +29,7 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
   const float a10 = static_cast<float>(s), a11 = static_cast<float>(c);
   const int stride = static_cast<int>(source.step1());
   const float* src = source.ptr<float>();
-  const bool avx2 = kernel == WarpKernel::kAuto && detail::cpuHasAvx2Fma();
+  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
   for (int y = 0; y < rows; ++y) {
     const double dy = y - cy;
     // Source point of output (0, y); column x adds x * (a00, a10).

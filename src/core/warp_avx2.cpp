@@ -5,8 +5,9 @@
 // with AVX2 in this file, could otherwise be the copy the linker keeps for portable callers.
 #include <immintrin.h>
 
+#include "avx2_lanes.h"
 #include "bilinear_sample.h"
-#include "warp_kernels.h"
+#include "simd_kernels.h"
 
 namespace oefmt {
 namespace detail {
@@ -42,10 +43,8 @@ void warpRowAvx2(const WarpRow& row) {
     }
     const __m256 fx = _mm256_sub_ps(sx, floor_x), fy = _mm256_sub_ps(sy, floor_y);
     const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(iy, vstride), ix);
-    const __m256 p00 = _mm256_i32gather_ps(src, index, 4);
-    const __m256 p01 = _mm256_i32gather_ps(src + 1, index, 4);
-    const __m256 p10 = _mm256_i32gather_ps(src + stride, index, 4);
-    const __m256 p11 = _mm256_i32gather_ps(src + stride + 1, index, 4);
+    __m256 p00, p01, p10, p11;
+    gatherNeighbours(src, stride, index, p00, p01, p10, p11);
     const __m256 top = _mm256_fmadd_ps(fx, _mm256_sub_ps(p01, p00), p00);
     const __m256 bottom = _mm256_fmadd_ps(fx, _mm256_sub_ps(p11, p10), p10);
     const __m256 value = _mm256_fmadd_ps(fy, _mm256_sub_ps(bottom, top), top);

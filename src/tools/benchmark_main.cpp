@@ -190,7 +190,7 @@ BENCHMARK(BM_Stage_HalfTurnTest)->Unit(benchmark::kMicrosecond);
 
 // Argument 0: the kernel the CPU check picks (AVX2 + FMA here); 1: the portable SSE kernel.
 void BM_Stage_WarpOlder(benchmark::State& state) {
-  const auto kernel = state.range(0) == 0 ? oefmt::WarpKernel::kAuto : oefmt::WarpKernel::kPortable;
+  const auto kernel = state.range(0) == 0 ? oefmt::SimdKernel::kAuto : oefmt::SimdKernel::kPortable;
   cv::Mat1f warped;
   for (auto _ : state) {
     oefmt::warpSimilarityWindowed(inputs().older.grey, 0.05, 1.03, inputs().context->window(),

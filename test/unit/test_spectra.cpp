@@ -197,8 +197,8 @@ TEST(Warp, FastKernelMatchesThePortableOne) {
   for (const double rotation : {0.0, 0.3, -2.0, 3.1}) {
     for (const double zoom : {1.0, 0.8, 1.3}) {
       cv::Mat1f fast, portable;
-      warpSimilarityWindowed(source, rotation, zoom, window, fast, 100.0f, WarpKernel::kAuto);
-      warpSimilarityWindowed(source, rotation, zoom, window, portable, 100.0f, WarpKernel::kPortable);
+      warpSimilarityWindowed(source, rotation, zoom, window, fast, 100.0f, SimdKernel::kAuto);
+      warpSimilarityWindowed(source, rotation, zoom, window, portable, 100.0f, SimdKernel::kPortable);
       // FMA rounds the sample position once instead of twice: ~1e-5 px, times the up to
       // 255-per-pixel slopes of this noise texture.
       EXPECT_LT(cv::norm(fast, portable, cv::NORM_INF), 1e-2) << rotation << " " << zoom;

@@ -1,0 +1,14 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Which code runs the per-pixel and per-frequency loops that have a CPU-specific version.
+#pragma once
+
+namespace oefmt {
+
+/// kAuto runs the AVX2 + FMA kernels when the CPU has both (the same results up to float
+/// rounding), kPortable the SSE code every x86-64-v2 CPU runs (for comparisons and benchmarks).
+enum class SimdKernel { kAuto, kPortable };
+
+/// True when kAuto picks the AVX2 + FMA kernels on this CPU.
+bool cpuRunsAvx2Kernels();
+
+}  // namespace oefmt

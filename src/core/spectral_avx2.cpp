@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// AVX2 + FMA kernels of the per-frequency loops (cross power, magnitude) and of the log-polar
+// resampling. Compiled with -mavx2 -mfma (CMakeLists.txt) and called only on CPUs that have
+// both; nothing but intrinsics, builtins and plain types in here (see warp_avx2.cpp for why).
+#include <immintrin.h>
+
+#include "avx2_lanes.h"
+#include "simd_kernels.h"
+
+namespace oefmt {
+namespace detail {
+namespace {
+
+// Keeps 0/0 out of the cross power without a branch (as the portable loop).
+constexpr float kTinyMagnitudeSquared = 1e-30f;
+
+}  // namespace
+
+void remapRowAvx2(const RemapRow& row) {
+  // The two horizontal neighbours are adjacent floats: 64-bit gathers fetch both (half the
+  // gathered elements of 32-bit gathers).
+  int c = 0;
+  for (; c + 8 <= row.count; c += 8) {
+    __m256 p00, p01, p10, p11;
+    gatherNeighbours(row.source, row.stride,
+                     _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row.offset + c)), p00,
+                     p01, p10, p11);
+    __m256 sum = _mm256_mul_ps(_mm256_loadu_ps(row.weight[0] + c), p00);
+    sum = _mm256_fmadd_ps(_mm256_loadu_ps(row.weight[1] + c), p01, sum);
+    sum = _mm256_fmadd_ps(_mm256_loadu_ps(row.weight[2] + c), p10, sum);
+    sum = _mm256_fmadd_ps(_mm256_loadu_ps(row.weight[3] + c), p11, sum);
+    _mm256_storeu_ps(row.out + c, sum);
+  }
+  for (; c < row.count; ++c) {
+    const float* p = row.source + row.offset[c];
+    row.out[c] = row.weight[0][c] * p[0] + row.weight[1][c] * p[1] +
+                 row.weight[2][c] * p[row.stride] + row.weight[3][c] * p[row.stride + 1];
+  }
+}
+
+void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
+                       float conjugate_sign, float factor, bool alternate) {
+  const float odd_factor = alternate ? -factor : factor;
+  const __m256 sign = _mm256_setr_ps(1.0f, conjugate_sign, 1.0f, conjugate_sign, 1.0f,
+                                     conjugate_sign, 1.0f, conjugate_sign);
+  // Four complex values per step, starting at an even index.
+  const __m256 factors = _mm256_setr_ps(factor, factor, odd_factor, odd_factor, factor, factor,
+                                        odd_factor, odd_factor);
+  const __m256 tiny = _mm256_set1_ps(kTinyMagnitudeSquared);
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const __m256 pv = _mm256_loadu_ps(p + 2 * i);
+    const __m256 qv = _mm256_mul_ps(_mm256_loadu_ps(q + 2 * i), sign);
+    const __m256 swapped = _mm256_permute_ps(pv, 0xB1);  // (pi, pr) pairs
+    // Even lanes: pr qr + pi qi; odd lanes: pi qr - pr qi.
+    const __m256 product = _mm256_fmsubadd_ps(pv, _mm256_moveldup_ps(qv),
+                                              _mm256_mul_ps(swapped, _mm256_movehdup_ps(qv)));
+    const __m256 squares = _mm256_mul_ps(product, product);
+    const __m256 norm = _mm256_add_ps(squares, _mm256_permute_ps(squares, 0xB1));
+    const __m256 scale = _mm256_div_ps(factors, _mm256_sqrt_ps(_mm256_add_ps(norm, tiny)));
+    _mm256_storeu_ps(out + 2 * i, _mm256_mul_ps(product, scale));
+  }
+  for (; i < count; ++i) {
+    const float pr = p[2 * i], pi = p[2 * i + 1];
+    const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
+    const float re = pr * qr + pi * qi;
+    const float im = pi * qr - pr * qi;
+    const float scale = ((i & 1) ? odd_factor : factor) /
+                        __builtin_sqrtf(re * re + im * im + kTinyMagnitudeSquared);
+    out[2 * i] = re * scale;
+    out[2 * i + 1] = im * scale;
+  }
+}
+
+void magnitudeRowAvx2(const float* complex_values, int count, float* out) {
+  int i = 0;
+  for (; i + 8 <= count; i += 8) {
+    __m256 re, im;
+    deinterleave(_mm256_loadu_ps(complex_values + 2 * i),
+                 _mm256_loadu_ps(complex_values + 2 * i + 8), re, im);
+    _mm256_storeu_ps(out + i, _mm256_sqrt_ps(_mm256_fmadd_ps(re, re, _mm256_mul_ps(im, im))));
+  }
+  for (; i < count; ++i) {
+    const float re = complex_values[2 * i], im = complex_values[2 * i + 1];
+    out[i] = __builtin_sqrtf(re * re + im * im);
+  }
+}
+
+}  // namespace detail
+}  // namespace oefmt
