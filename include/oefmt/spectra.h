@@ -4,19 +4,21 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "oefmt/config.h"
 #include "oefmt/fft.h"
 #include "oefmt/image_prep.h"
-#include "oefmt/remap_table.h"
+#include "oefmt/simd_kernel.h"
 #include "oefmt/window.h"
 
 namespace oefmt {
 
 /// Everything that depends only on the configuration: FFT plans, apodization window, high-pass
-/// filter and the remap tables of the log-polar and polar resamplings. Immutable after
+/// filter and the rays of the log-polar resampling (samples are computed on the fly: a table of
+/// them was 5 MB, read once per frame, slower than computing them). Immutable after
 /// construction and safe to share between threads.
 class SpectralContext {
  public:
@@ -39,11 +41,13 @@ class SpectralContext {
 
   /// Upper half of the centred, high-passed magnitude (see upperHalfMagnitude) -> log-polar
   /// (rows: angle 0..-pi, columns: log radius). Bilinear.
-  void logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out) const;
+  void logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out,
+                SimdKernel kernel = SimdKernel::kAuto) const;
   /// Rows first_row .. first_row + count - 1 (cyclic) of the polar unwrap of a centred
-  /// correlation surface (rows: direction 2 pi row / N, columns: radius). Bilinear, computed
-  /// directly: only a band of rows is ever needed, so no table is kept.
-  void polarRows(const cv::Mat1f& centred_surface, int first_row, int count, cv::Mat1f& out) const;
+  /// correlation surface (rows: direction 2 pi row / N, columns: radius). Bilinear; the
+  /// surface may be a view with padded rows.
+  void polarRows(const cv::Mat1f& centred_surface, int first_row, int count, cv::Mat1f& out,
+                 SimdKernel kernel = SimdKernel::kAuto) const;
 
  private:
   RegistrationConfig config_;
@@ -53,7 +57,8 @@ class SpectralContext {
   double log_polar_base_;
   double polar_radius_step_;
   Fft2d small_fft_;
-  BilinearRemapTable log_polar_table_;
+  // Log-polar ray of row i: direction (cos, sin)[i]; column j samples radius radii[j].
+  std::vector<float> log_polar_cos_, log_polar_sin_, log_polar_radii_;
 };
 
 /// What the registration needs of one frame; computed once when the frame arrives.

@@ -1,37 +1,35 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Private to src/core: the AVX2 + FMA kernels (the *_avx2.cpp files, compiled with -mavx2
-// -mfma) and what they are given. Call them only when cpuRunsAvx2Kernels() is true.
+// Private to src/core: the loops that have a CPU-specific version. The *Avx2 kernels (the
+// *_avx2.cpp files, compiled with -mavx2 -mfma) run only when cpuRunsAvx2Kernels() is true.
 #pragma once
-
-#include <cstdint>
 
 namespace oefmt {
 namespace detail {
 
-/// Row y of warpSimilarityWindowed: source point of output column x is
-/// (sx0 + a00 x, sy0 + a10 x); out[x] = row_weight * taper[x] * (bilinear - offset).
-struct WarpRow {
+/// Bilinear samples along a line of the source (a warp row, a polar or log-polar ray):
+/// column c samples (sx0 + dx t_c, sy0 + dy t_c), t_c = positions[c] (or c when positions is
+/// null), and out[c] = row_weight * taper[c] * (bilinear - offset) (taper null: row_weight);
+/// neighbours outside the source count as `offset`, i.e. 0 after the subtraction.
+struct LineSamples {
   const float* source;
   int stride, cols, rows;
-  float sx0, sy0, a00, a10;
+  float sx0, sy0, dx, dy;
+  const float* positions;
   float row_weight;
   const float* taper;
   float offset;
-  float* out;
-};
-void warpRowAvx2(const WarpRow& row);
-
-/// One row of a BilinearRemapTable: out[c] = w0 p[0] + w1 p[1] + w2 p[stride] + w3 p[stride + 1]
-/// with p = source + offset[c].
-struct RemapRow {
-  const float* source;
-  int stride;
-  const std::int32_t* offset;
-  const float* weight[4];
   int count;
   float* out;
 };
-void remapRowAvx2(const RemapRow& row);
+void sampleLinePortable(const LineSamples& line);  // line_sampling.cpp (SSE / NEON)
+void sampleLineAvx2(const LineSamples& line);      // line_sampling_avx2.cpp
+inline void sampleLine(const LineSamples& line, bool avx2) {
+  if (avx2) {
+    sampleLineAvx2(line);
+  } else {
+    sampleLinePortable(line);
+  }
+}
 
 /// `count` interleaved complex values: out = p * conj(q) / |p * conj(q)| (q not conjugated
 /// when conjugate_sign is -1), element i times factor, and times (-1)^i when `alternate`.

@@ -41,48 +41,67 @@ SpectralContext::SpectralContext(const RegistrationConfig& config)
       log_polar_base_(std::pow(config.logpolar_radius_fraction * config.size, 1.0 / config.size)),
       polar_radius_step_(config.polar_radius_fraction),
       small_fft_(std::min(128, config.size / 2), config.fft_planning) {
-  const int n = config.size;
-  const double centre = n / 2;
-  const double base = log_polar_base_;
   // Rows span exactly pi (the magnitude is point-symmetric), so the row axis is cyclic. Angles
   // 0..-pi only reach the upper half plane: rows 0..N/2 (+1 for the bilinear neighbour).
-  log_polar_table_ = BilinearRemapTable({n, n}, {n, n / 2 + 2}, [&](int r, int c) {
-    const double angle = -CV_PI * r / n;
-    const double radius = std::pow(base, c);
-    return cv::Point2d(centre + radius * std::cos(angle), centre + radius * std::sin(angle));
-  });
+  const int n = config.size;
+  log_polar_cos_.resize(n);
+  log_polar_sin_.resize(n);
+  log_polar_radii_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double angle = -CV_PI * i / n;
+    log_polar_cos_[i] = static_cast<float>(std::cos(angle));
+    log_polar_sin_[i] = static_cast<float>(std::sin(angle));
+    log_polar_radii_[i] = static_cast<float>(std::pow(log_polar_base_, i));
+  }
 }
 
-void SpectralContext::logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out) const {
-  log_polar_table_.apply(upper_half_magnitude, out);
+void SpectralContext::logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f& out,
+                               SimdKernel kernel) const {
+  const int n = config_.size;
+  if (upper_half_magnitude.rows != n / 2 + 2 || upper_half_magnitude.cols != n) {
+    throw InputError("logPolar: magnitude of the wrong size");
+  }
+  out.create(n, n);
+  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+  for (int i = 0; i < n; ++i) {
+    detail::LineSamples ray{};
+    ray.source = upper_half_magnitude.ptr<float>();
+    ray.stride = static_cast<int>(upper_half_magnitude.step1());
+    ray.cols = n;
+    ray.rows = upper_half_magnitude.rows;
+    ray.sx0 = ray.sy0 = static_cast<float>(n / 2);
+    ray.dx = log_polar_cos_[i];
+    ray.dy = log_polar_sin_[i];
+    ray.positions = log_polar_radii_.data();
+    ray.row_weight = 1.0f;
+    ray.count = n;
+    ray.out = out[i];
+    detail::sampleLine(ray, avx2);
+  }
 }
 
 void SpectralContext::polarRows(const cv::Mat1f& centred_surface, int first_row, int count,
-                                cv::Mat1f& out) const {
+                                cv::Mat1f& out, SimdKernel kernel) const {
   const int n = config_.size;
   if (centred_surface.rows != n || centred_surface.cols != n) {
     throw InputError("polarRows: surface of the wrong size");
   }
   out.create(count, n);
-  const double centre = n / 2;
+  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
   for (int i = 0; i < count; ++i) {
+    // Zero outside the surface (no cyclic wrap: radii beyond N/2 are not aliases).
     const double direction = 2.0 * CV_PI * (first_row + i) / n;
-    const double dx = polar_radius_step_ * std::cos(direction);
-    const double dy = polar_radius_step_ * std::sin(direction);
-    float* row = out[i];
-    for (int c = 0; c < n; ++c) {
-      // Bilinear, 0 outside the surface (no cyclic wrap: radii beyond N/2 are not aliases).
-      const double x = centre + c * dx, y = centre + c * dy;
-      const double x0 = std::floor(x), y0 = std::floor(y);
-      const int xi = static_cast<int>(x0), yi = static_cast<int>(y0);
-      const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
-      auto at = [&](int xx, int yy) -> float {
-        return (xx < 0 || yy < 0 || xx >= n || yy >= n) ? 0.0f : centred_surface(yy, xx);
-      };
-      const float top = at(xi, yi) + fx * (at(xi + 1, yi) - at(xi, yi));
-      const float bottom = at(xi, yi + 1) + fx * (at(xi + 1, yi + 1) - at(xi, yi + 1));
-      row[c] = top + fy * (bottom - top);
-    }
+    detail::LineSamples ray{};
+    ray.source = centred_surface.ptr<float>();
+    ray.stride = static_cast<int>(centred_surface.step1());
+    ray.cols = ray.rows = n;
+    ray.sx0 = ray.sy0 = static_cast<float>(n / 2);
+    ray.dx = static_cast<float>(polar_radius_step_ * std::cos(direction));
+    ray.dy = static_cast<float>(polar_radius_step_ * std::sin(direction));
+    ray.row_weight = 1.0f;
+    ray.count = n;
+    ray.out = out[i];
+    detail::sampleLine(ray, avx2);
   }
 }
 

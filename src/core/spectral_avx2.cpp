@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// AVX2 + FMA kernels of the per-frequency loops (cross power, magnitude) and of the log-polar
-// resampling. Compiled with -mavx2 -mfma (CMakeLists.txt) and called only on CPUs that have
-// both; nothing but intrinsics, builtins and plain types in here (see warp_avx2.cpp for why).
+// AVX2 + FMA kernels of the per-frequency loops (cross power, magnitude). Compiled with -mavx2 -mfma (CMakeLists.txt) and called only on CPUs that have
+// both; nothing but intrinsics, builtins and plain types in here (see line_sampling_avx2.cpp for why).
 #include <immintrin.h>
 
 #include "avx2_lanes.h"
@@ -15,28 +14,6 @@ namespace {
 constexpr float kTinyMagnitudeSquared = 1e-30f;
 
 }  // namespace
-
-void remapRowAvx2(const RemapRow& row) {
-  // The two horizontal neighbours are adjacent floats: 64-bit gathers fetch both (half the
-  // gathered elements of 32-bit gathers).
-  int c = 0;
-  for (; c + 8 <= row.count; c += 8) {
-    __m256 p00, p01, p10, p11;
-    gatherNeighbours(row.source, row.stride,
-                     _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row.offset + c)), p00,
-                     p01, p10, p11);
-    __m256 sum = _mm256_mul_ps(_mm256_loadu_ps(row.weight[0] + c), p00);
-    sum = _mm256_fmadd_ps(_mm256_loadu_ps(row.weight[1] + c), p01, sum);
-    sum = _mm256_fmadd_ps(_mm256_loadu_ps(row.weight[2] + c), p10, sum);
-    sum = _mm256_fmadd_ps(_mm256_loadu_ps(row.weight[3] + c), p11, sum);
-    _mm256_storeu_ps(row.out + c, sum);
-  }
-  for (; c < row.count; ++c) {
-    const float* p = row.source + row.offset[c];
-    row.out[c] = row.weight[0][c] * p[0] + row.weight[1][c] * p[1] +
-                 row.weight[2][c] * p[row.stride] + row.weight[3][c] * p[row.stride + 1];
-  }
-}
 
 void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
                        float conjugate_sign, float factor, bool alternate) {

@@ -8,7 +8,7 @@
 
 #include "oefmt/fft.h"
 #include "oefmt/phase_correlation.h"
-#include "oefmt/remap_table.h"
+#include "oefmt/config.h"
 #include "oefmt/spectra.h"
 
 namespace oefmt {
@@ -59,31 +59,61 @@ TEST(SimdKernels, MagnitudeMatchesThePortableLoop) {
   EXPECT_NEAR(fast(n / 2 - 3, n / 2 - 5), std::hypot(mirror[0], mirror[1]) * filter(n / 2 - 3, n / 2 - 5), 1e-3);
 }
 
-TEST(SimdKernels, RemapMatchesThePortableLoop) {
-  // 37 output columns (a tail after eight-wide steps), samples all over a 40 x 30 source and
-  // beyond its border (outside neighbours weigh nothing).
-  const cv::Size output(37, 23), source_size(40, 30);
-  const BilinearRemapTable table(output, source_size, [](int r, int c) {
-    return cv::Point2d(-1.5 + 1.17 * c + 0.05 * r, -0.7 + 1.41 * r - 0.03 * c);
-  });
-  cv::Mat1f source(source_size);
-  cv::randu(source, -10.0f, 10.0f);
-  cv::Mat1f fast, portable, fast_rows, portable_rows;
-  table.apply(source, fast, SimdKernel::kAuto);
-  table.apply(source, portable, SimdKernel::kPortable);
-  EXPECT_LT(cv::norm(fast, portable, cv::NORM_INF), 1e-4);
-  EXPECT_GT(cv::norm(portable, cv::NORM_INF), 1.0);
-  table.applyRows(source, 20, 6, fast_rows, SimdKernel::kAuto);  // wraps past the last row
-  table.applyRows(source, 20, 6, portable_rows, SimdKernel::kPortable);
-  EXPECT_LT(cv::norm(fast_rows, portable_rows, cv::NORM_INF), 1e-4);
-  EXPECT_LT(cv::norm(fast_rows.row(4), fast.row(1), cv::NORM_INF), 1e-6);
-  // One sample against bilinear interpolation written out.
-  const double x = -1.5 + 1.17 * 10 + 0.05 * 4, y = -0.7 + 1.41 * 4 - 0.03 * 10;
+// Bilinear interpolation written out, 0 outside (the reference for the ray samplers).
+double bilinear(const cv::Mat1f& image, double x, double y) {
   const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
   const double fx = x - x0, fy = y - y0;
-  const double expected = (1 - fx) * (1 - fy) * source(y0, x0) + fx * (1 - fy) * source(y0, x0 + 1) +
-                          (1 - fx) * fy * source(y0 + 1, x0) + fx * fy * source(y0 + 1, x0 + 1);
-  EXPECT_NEAR(fast(4, 10), expected, 1e-4);
+  auto at = [&](int c, int r) -> double {
+    return (c < 0 || r < 0 || c >= image.cols || r >= image.rows) ? 0.0 : image(r, c);
+  };
+  return (1 - fx) * (1 - fy) * at(x0, y0) + fx * (1 - fy) * at(x0 + 1, y0) +
+         (1 - fx) * fy * at(x0, y0 + 1) + fx * fy * at(x0 + 1, y0 + 1);
+}
+
+TEST(SimdKernels, LogPolarRaysMatchThePortableLoopAndBilinearSampling) {
+  RegistrationConfig config;
+  config.size = 68;  // 68 columns: a tail of four after eight-wide steps
+  config.fft_planning = FftPlanning::kEstimate;
+  const SpectralContext context(config);
+  const int n = config.size;
+  cv::Mat1f magnitude(n / 2 + 2, n);
+  cv::randu(magnitude, 0.0f, 10.0f);
+  cv::Mat1f fast, portable;
+  context.logPolar(magnitude, fast, SimdKernel::kAuto);
+  context.logPolar(magnitude, portable, SimdKernel::kPortable);
+  EXPECT_LT(cv::norm(fast, portable, cv::NORM_INF), 1e-4);
+  // Row i: angle -pi i / N; column j: radius b^j about (N/2, N/2), outer radii beyond the
+  // border (partly zero).
+  for (const cv::Point at : {cv::Point(0, 0), cv::Point(5, 17), cv::Point(67, 30), cv::Point(40, 67)}) {
+    const double angle = -CV_PI * at.y / n, radius = std::pow(context.logPolarBase(), at.x);
+    const double expected = bilinear(magnitude, n / 2 + radius * std::cos(angle),
+                                     n / 2 + radius * std::sin(angle));
+    EXPECT_NEAR(fast(at.y, at.x), expected, 1e-3) << at;
+  }
+}
+
+TEST(SimdKernels, PolarRowsMatchThePortableLoopOnAPaddedSurface) {
+  RegistrationConfig config;
+  config.size = 68;
+  config.fft_planning = FftPlanning::kEstimate;
+  const SpectralContext context(config);
+  const int n = config.size;
+  // The registration unwraps a view of an in-place FFT buffer (rows padded).
+  cv::Mat2f buffer;
+  cv::Mat1f surface = context.fft().inPlaceInput(buffer);
+  ASSERT_FALSE(surface.isContinuous());
+  cv::randu(surface, -1.0f, 1.0f);
+  cv::Mat1f fast, portable;
+  context.polarRows(surface, -3, 7, fast, SimdKernel::kAuto);  // rows wrap below 0
+  context.polarRows(surface, -3, 7, portable, SimdKernel::kPortable);
+  EXPECT_LT(cv::norm(fast, portable, cv::NORM_INF), 1e-5);
+  for (const cv::Point at : {cv::Point(0, 0), cv::Point(13, 1), cv::Point(29, 6), cv::Point(55, 4)}) {
+    const double direction = 2.0 * CV_PI * (at.y - 3) / n;
+    const double radius = context.polarRadiusStep() * at.x;
+    const double expected = bilinear(surface, n / 2 + radius * std::cos(direction),
+                                     n / 2 + radius * std::sin(direction));
+    EXPECT_NEAR(fast(at.y, at.x), expected, 1e-4) << at;
+  }
 }
 
 }  // namespace
