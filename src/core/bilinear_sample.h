@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Private to src/core: the scalar bilinear sample of the similarity warp, shared by the portable
-// warp and its AVX2 kernel. `static` on purpose: each translation unit keeps its own copy, so
+// Private to src/core: the scalar bilinear sample of the line sampler, shared by its portable
+// and AVX2 kernels. `static` on purpose: each translation unit keeps its own copy, so
 // the copy compiled with -mavx2 can never be the one the linker picks for portable code.
 #pragma once
+
+#include "simd_kernels.h"
 
 namespace oefmt {
 namespace detail {
@@ -21,6 +23,14 @@ static inline float sampleBilinear(const float* src, int stride, int cols, int r
   const float top = at(x0, y0) + fx * (at(x0 + 1, y0) - at(x0, y0));
   const float bottom = at(x0, y0 + 1) + fx * (at(x0 + 1, y0 + 1) - at(x0, y0 + 1));
   return top + fy * (bottom - top);
+}
+
+/// Column c of a LineSamples, one sample at a time (the kernels' border and tail path).
+static inline void sampleLineAt(const LineSamples& line, int c) {
+  const float t = line.positions ? line.positions[c] : static_cast<float>(c);
+  const float weight = line.taper ? line.row_weight * line.taper[c] : line.row_weight;
+  line.out[c] = weight * sampleBilinear(line.source, line.stride, line.cols, line.rows,
+                                        line.sx0 + line.dx * t, line.sy0 + line.dy * t, line.offset);
 }
 
 }  // namespace detail

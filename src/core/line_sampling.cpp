@@ -4,7 +4,6 @@
 #include <opencv2/core/hal/intrin.hpp>
 
 #include "bilinear_sample.h"
-#include "simd_kernels.h"
 
 namespace oefmt {
 namespace detail {
@@ -12,13 +11,6 @@ namespace detail {
 void sampleLinePortable(const LineSamples& line) {
   const float* src = line.source;
   const int cols = line.cols, rows = line.rows, stride = line.stride;
-  auto position = [&](int c) { return line.positions ? line.positions[c] : static_cast<float>(c); };
-  auto scalar = [&](int c) {
-    const float t = position(c);
-    const float w = line.taper ? line.row_weight * line.taper[c] : line.row_weight;
-    line.out[c] = w * sampleBilinear(src, stride, cols, rows, line.sx0 + line.dx * t,
-                                     line.sy0 + line.dy * t, line.offset);
-  };
   int c = 0;
 #if CV_SIMD128
   const cv::v_float32x4 lanes(0.0f, 1.0f, 2.0f, 3.0f);
@@ -37,7 +29,7 @@ void sampleLinePortable(const LineSamples& line) {
     // Four samples at a time where the whole 2 x 2 neighbourhood is inside the source.
     const cv::v_int32x4 inside = (ix >= zero) & (iy >= zero) & (ix <= max_x) & (iy <= max_y);
     if (!cv::v_check_all(inside)) {
-      for (int k = c; k < c + 4; ++k) scalar(k);
+      for (int k = c; k < c + 4; ++k) sampleLineAt(line, k);
       continue;
     }
     const cv::v_float32x4 fx = sx - cv::v_cvt_f32(ix), fy = sy - cv::v_cvt_f32(iy);
@@ -51,7 +43,7 @@ void sampleLinePortable(const LineSamples& line) {
     cv::v_store(line.out + c, (top + fy * (bottom - top) - offset) * w);
   }
 #endif
-  for (; c < line.count; ++c) scalar(c);
+  for (; c < line.count; ++c) sampleLineAt(line, c);
 }
 
 }  // namespace detail

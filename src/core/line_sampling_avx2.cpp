@@ -8,7 +8,6 @@
 
 #include "avx2_lanes.h"
 #include "bilinear_sample.h"
-#include "simd_kernels.h"
 
 namespace oefmt {
 namespace detail {
@@ -23,13 +22,6 @@ void sampleLineAvx2(const LineSamples& line) {
   const __m256i zero = _mm256_setzero_si256();
   const __m256i max_x = _mm256_set1_epi32(cols - 2), max_y = _mm256_set1_epi32(rows - 2);
   const __m256i vstride = _mm256_set1_epi32(stride);
-  auto position = [&](int c) { return line.positions ? line.positions[c] : static_cast<float>(c); };
-  auto scalar = [&](int c) {
-    const float t = position(c);
-    const float w = line.taper ? line.row_weight * line.taper[c] : line.row_weight;
-    line.out[c] = w * sampleBilinear(src, stride, cols, rows, line.sx0 + line.dx * t,
-                                     line.sy0 + line.dy * t, line.offset);
-  };
   int c = 0;
   for (; c + 8 <= line.count; c += 8) {
     const __m256 t = line.positions ? _mm256_loadu_ps(line.positions + c)
@@ -43,7 +35,7 @@ void sampleLineAvx2(const LineSamples& line) {
         _mm256_or_si256(_mm256_cmpgt_epi32(zero, ix), _mm256_cmpgt_epi32(ix, max_x)),
         _mm256_or_si256(_mm256_cmpgt_epi32(zero, iy), _mm256_cmpgt_epi32(iy, max_y)));
     if (!_mm256_testz_si256(outside, outside)) {
-      for (int k = c; k < c + 8; ++k) scalar(k);
+      for (int k = c; k < c + 8; ++k) sampleLineAt(line, k);
       continue;
     }
     const __m256 fx = _mm256_sub_ps(sx, floor_x), fy = _mm256_sub_ps(sy, floor_y);
@@ -56,7 +48,7 @@ void sampleLineAvx2(const LineSamples& line) {
     const __m256 w = line.taper ? _mm256_mul_ps(_mm256_loadu_ps(line.taper + c), weight) : weight;
     _mm256_storeu_ps(line.out + c, _mm256_mul_ps(_mm256_sub_ps(value, offset), w));
   }
-  for (; c < line.count; ++c) scalar(c);
+  for (; c < line.count; ++c) sampleLineAt(line, c);
 }
 
 }  // namespace detail

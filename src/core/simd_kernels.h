@@ -23,7 +23,8 @@ struct LineSamples {
 };
 void sampleLinePortable(const LineSamples& line);  // line_sampling.cpp (SSE / NEON)
 void sampleLineAvx2(const LineSamples& line);      // line_sampling_avx2.cpp
-inline void sampleLine(const LineSamples& line, bool avx2) {
+// `static`: a copy of this inline dispatcher emitted by an -mavx2 file can never serve others.
+static inline void sampleLine(const LineSamples& line, bool avx2) {
   if (avx2) {
     sampleLineAvx2(line);
   } else {
