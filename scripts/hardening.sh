@@ -3,12 +3,15 @@
 # Hardening checks (issue 6), separate from the main build. One clang++-14 build of fuzz/ (the
 # core instrumented with AddressSanitizer + UBSan and libFuzzer's coverage) gives:
 #   1. the unit tests under the sanitizers;
-#   2. the libFuzzer targets, each run for SECONDS on a copy of its seeds.
+#   2. the libFuzzer targets, each run for SECONDS on a copy of its seeds;
+# and 3. the ROS-free core (src/core) compiled for aarch64 (ARM companion computers: the NEON
+#    paths; the AVX2 files are stubs there) with warnings as errors (g++-aarch64-linux-gnu).
 # (The catkin build can also be sanitised with gcc: -DOEFMT_SANITIZE=ON.)
 # Usage: bash scripts/hardening.sh BUILD_ROOT [SECONDS]   (SECONDS per fuzz target, default 20)
 # Writes JUnit XML into OEFMT_RESULTS_DIR (default BUILD_ROOT/test_results/oefmt):
 #   sanitizers-oefmt_unit_tests.xml (gtest), sanitizers-exit.xml (only when the run died or
-#   leaked after gtest wrote its file) and fuzz.xml (one case per fuzz target).
+#   leaked after gtest wrote its file), fuzz.xml (one case per fuzz target) and
+#   portability.xml (one case per core source compiled for aarch64).
 # Exits non-zero on any failure. Builds are incremental when BUILD_ROOT is reused.
 set -uo pipefail
 
@@ -170,6 +173,48 @@ else
   for target in "${targets[@]}"; do cases+=("$target" "sanitizer build failed" "$fuzz_log"); done
 fi
 junit "$results/fuzz.xml" Fuzz "${cases[@]}"
+
+# ---------------------------------------------------------------------------------------------
+# 3. The core on ARM: compile every src/core file for aarch64 (compile only: Debian has no
+#    aarch64 OpenCV/Ceres here to link against). OpenCV's and Eigen's headers are the host's.
+# ---------------------------------------------------------------------------------------------
+section "Portability: src/core compiled for aarch64"
+arm="$root/aarch64"
+mkdir -p "$arm"
+cases=()
+if command -v aarch64-linux-gnu-g++ >/dev/null; then
+  compile_arm() {
+    local source="$1" name
+    name="$(basename "$source" .cpp)"
+    aarch64-linux-gnu-g++ -std=c++17 -O2 -Wall -Wextra -Werror -fno-math-errno -fopenmp-simd \
+      -I"$repo/include" -isystem /usr/include/opencv4 -isystem /usr/include/eigen3 \
+      -idirafter /usr/include -c "$source" -o "$arm/$name.o" >"$arm/$name.log" 2>&1
+    echo $? >"$arm/$name.status"
+  }
+  export -f compile_arm
+  export repo arm
+  printf '%s\n' "$repo"/src/core/*.cpp | xargs -P "$jobs" -I{} bash -c 'compile_arm "$1"' _ {}
+  compiled=0 sources=0
+  for source in "$repo"/src/core/*.cpp; do
+    name="$(basename "$source" .cpp)"
+    sources=$((sources + 1))
+    if [ "$(cat "$arm/$name.status" 2>/dev/null)" = 0 ]; then
+      compiled=$((compiled + 1))
+      cases+=("$name" ok "$arm/$name.log")
+    else
+      failed=1
+      echo "FAILED: $name for aarch64 (log: $arm/$name.log)"
+      head -n 20 "$arm/$name.log"
+      cases+=("$name" "does not compile for aarch64" "$arm/$name.log")
+    fi
+  done
+  echo "$compiled of $sources core sources compile for aarch64"
+else
+  failed=1
+  echo "FAILED: aarch64-linux-gnu-g++ missing (apt install g++-aarch64-linux-gnu)"
+  cases+=(aarch64-compiler "aarch64-linux-gnu-g++ missing" /dev/null)
+fi
+junit "$results/portability.xml" Portability "${cases[@]}"
 
 section "Hardening: $([ $failed = 0 ] && echo passed || echo FAILED) in $((SECONDS - start))s (results: $results)"
 exit $failed

@@ -21,8 +21,8 @@ packages=(
   rosbash python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs
   python3-tf2-ros python3-numpy python3-matplotlib
 )
-# The test command also builds the sanitizer and fuzzing checks (scripts/hardening.sh).
-test_packages=(clang-14 libclang-rt-14-dev)
+# The test command also builds the sanitizer, fuzzing and ARM checks (scripts/hardening.sh).
+test_packages=(clang-14 libclang-rt-14-dev g++-aarch64-linux-gnu)
 
 install_dependencies() {
   [ "${OEFMT_SKIP_INSTALL:-0}" = 1 ] && return 0

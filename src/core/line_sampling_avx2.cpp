@@ -4,6 +4,7 @@
 // on CPUs that have both. Nothing but intrinsics and plain types in here: an inline function
 // from a shared header, compiled with AVX2 in this file, could otherwise be the copy the
 // linker keeps for portable callers.
+#if defined(__x86_64__)
 #include <immintrin.h>
 
 #include "avx2_lanes.h"
@@ -53,3 +54,19 @@ void sampleLineAvx2(const LineSamples& line) {
 
 }  // namespace detail
 }  // namespace oefmt
+
+#else  // not x86-64: never called (cpuRunsAvx2Kernels() is false there); defined for the linker.
+
+#include <cstdlib>
+
+#include "simd_kernels.h"
+
+namespace oefmt {
+namespace detail {
+
+void sampleLineAvx2(const LineSamples&) { std::abort(); }
+
+}  // namespace detail
+}  // namespace oefmt
+
+#endif

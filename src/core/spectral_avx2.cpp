@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // AVX2 + FMA kernels of the per-frequency loops (cross power, magnitude). Compiled with -mavx2 -mfma (CMakeLists.txt) and called only on CPUs that have
 // both; nothing but intrinsics, builtins and plain types in here (see line_sampling_avx2.cpp for why).
+#if defined(__x86_64__)
 #include <immintrin.h>
 
 #include "avx2_lanes.h"
@@ -65,3 +66,20 @@ void magnitudeRowAvx2(const float* complex_values, int count, float* out) {
 
 }  // namespace detail
 }  // namespace oefmt
+
+#else  // not x86-64: never called (cpuRunsAvx2Kernels() is false there); defined for the linker.
+
+#include <cstdlib>
+
+#include "simd_kernels.h"
+
+namespace oefmt {
+namespace detail {
+
+void crossPowerRowAvx2(const float*, const float*, float*, int, float, float, bool) { std::abort(); }
+void magnitudeRowAvx2(const float*, int, float*) { std::abort(); }
+
+}  // namespace detail
+}  // namespace oefmt
+
+#endif
