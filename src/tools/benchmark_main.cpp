@@ -4,6 +4,8 @@
 // pass --threads K to let OpenCV use K threads.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -56,23 +58,58 @@ Inputs& inputs() {
   return instance;
 }
 
+// Seconds of one 512 x 512 FFTW forward + inverse pair as the pipeline runs them, right now
+// (the fastest of three batches of ten): the yardstick of the "fft_pairs" counters below.
+double fftPairSeconds() {
+  const oefmt::Fft2d& fft = inputs().context->fft();
+  cv::Mat2f buffer;
+  fft.inPlaceInput(buffer);
+  double best = 1e9;
+  for (int batch = 0; batch < 3; ++batch) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < 10; ++i) {
+      fft.forward(inputs().newer.grey, buffer);
+      fft.inverseInPlace(buffer);
+    }
+    const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+    best = std::min(best, elapsed.count() / 10);
+  }
+  return best;
+}
+
+// Runs `body` as the benchmark loop and reports its time per iteration in FFT pairs measured
+// just before and after it ("fft_pairs"): a figure the host's drift (up to 2-3x here) does not
+// change, to compare with issue 2's targets (8 ms and 5.5 ms at 0.9 ms per FFT pair).
+template <typename Body>
+void timeInFftPairs(benchmark::State& state, Body body) {
+  const double before = fftPairSeconds();
+  const auto start = std::chrono::steady_clock::now();
+  for (auto _ : state) body();
+  const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+  const double yardstick = 0.5 * (before + fftPairSeconds());
+  if (state.iterations() > 0) {
+    state.counters["fft_pairs"] = elapsed.count() / static_cast<double>(state.iterations()) / yardstick;
+  }
+  state.counters["fft_pair_ms"] = 1e3 * yardstick;
+}
+
 void BM_PairFromRawImages(benchmark::State& state) {
   oefmt::Registrar registrar(inputs().context);
-  for (auto _ : state) {
+  timeInFftPairs(state, [&] {
     const oefmt::FrameSpectra a = registrar.analyse(inputs().older_raw);
     const oefmt::FrameSpectra b = registrar.analyse(inputs().newer_raw);
     benchmark::DoNotOptimize(registrar.registerPair(a, b));
-  }
+  });
 }
 BENCHMARK(BM_PairFromRawImages)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_PairWithCachedOlder(benchmark::State& state) {
   oefmt::Registrar registrar(inputs().context);
   const oefmt::FrameSpectra a = registrar.analyse(inputs().older_raw);
-  for (auto _ : state) {
+  timeInFftPairs(state, [&] {
     const oefmt::FrameSpectra b = registrar.analyse(inputs().newer_raw);
     benchmark::DoNotOptimize(registrar.registerPair(a, b));
-  }
+  });
 }
 BENCHMARK(BM_PairWithCachedOlder)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
@@ -80,7 +117,7 @@ void BM_RegisterCachedSpectra(benchmark::State& state) {
   oefmt::Registrar registrar(inputs().context);
   const oefmt::FrameSpectra a = registrar.analyse(inputs().older);
   const oefmt::FrameSpectra b = registrar.analyse(inputs().newer);
-  for (auto _ : state) benchmark::DoNotOptimize(registrar.registerPair(a, b));
+  timeInFftPairs(state, [&] { benchmark::DoNotOptimize(registrar.registerPair(a, b)); });
 }
 BENCHMARK(BM_RegisterCachedSpectra)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
