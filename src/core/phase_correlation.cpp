@@ -25,7 +25,7 @@ int wrap(int i, int n) { return ((i % n) + n) % n; }
 // vectorises it (the AVX2 kernel computes the same).
 void crossPowerRun(const float* p, const float* q, float* out, int count, float conjugate_sign,
                    float factor, bool alternate, SimdKernel kernel) {
-  if (kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels()) {
+  if (detail::runsAvx2(kernel)) {
     detail::crossPowerRowAvx2(p, q, out, count, conjugate_sign, factor, alternate);
     return;
   }

@@ -4,8 +4,15 @@
 // is true; elsewhere those files hold stubs that are never called.
 #pragma once
 
+#include "oefmt/simd_kernel.h"
+
 namespace oefmt {
 namespace detail {
+
+/// Whether `kernel` means the AVX2 kernels on this CPU. (`static`: see sampleLine.)
+static inline bool runsAvx2(SimdKernel kernel) {
+  return kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+}
 
 /// Bilinear samples along a line of the source (a warp row, a polar or log-polar ray):
 /// column c samples (sx0 + dx t_c, sy0 + dy t_c), t_c = positions[c] (or c when positions is

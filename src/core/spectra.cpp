@@ -31,6 +31,26 @@ cv::Mat1f makeHighPass(int n) {
   return filter;
 }
 
+// One row of a polar or log-polar unwrap: `source` (rows may be padded) sampled bilinearly at
+// (N/2, N/2) + t_c (dx, dy), t_c = positions[c] (or c when null), for the source's N columns;
+// zero outside.
+void sampleRay(const cv::Mat1f& source, float dx, float dy, const float* positions, float* out,
+               bool avx2) {
+  detail::LineSamples ray{};
+  ray.source = source.ptr<float>();
+  ray.stride = static_cast<int>(source.step1());
+  ray.cols = source.cols;
+  ray.rows = source.rows;
+  ray.sx0 = ray.sy0 = static_cast<float>(source.cols / 2);
+  ray.dx = dx;
+  ray.dy = dy;
+  ray.positions = positions;
+  ray.row_weight = 1.0f;
+  ray.count = source.cols;
+  ray.out = out;
+  detail::sampleLine(ray, avx2);
+}
+
 }  // namespace
 
 SpectralContext::SpectralContext(const RegistrationConfig& config)
@@ -62,21 +82,10 @@ void SpectralContext::logPolar(const cv::Mat1f& upper_half_magnitude, cv::Mat1f&
     throw InputError("logPolar: magnitude of the wrong size");
   }
   out.create(n, n);
-  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+  const bool avx2 = detail::runsAvx2(kernel);
   for (int i = 0; i < n; ++i) {
-    detail::LineSamples ray{};
-    ray.source = upper_half_magnitude.ptr<float>();
-    ray.stride = static_cast<int>(upper_half_magnitude.step1());
-    ray.cols = n;
-    ray.rows = upper_half_magnitude.rows;
-    ray.sx0 = ray.sy0 = static_cast<float>(n / 2);
-    ray.dx = log_polar_cos_[i];
-    ray.dy = log_polar_sin_[i];
-    ray.positions = log_polar_radii_.data();
-    ray.row_weight = 1.0f;
-    ray.count = n;
-    ray.out = out[i];
-    detail::sampleLine(ray, avx2);
+    sampleRay(upper_half_magnitude, log_polar_cos_[i], log_polar_sin_[i], log_polar_radii_.data(),
+              out[i], avx2);
   }
 }
 
@@ -87,21 +96,12 @@ void SpectralContext::polarRows(const cv::Mat1f& centred_surface, int first_row,
     throw InputError("polarRows: surface of the wrong size");
   }
   out.create(count, n);
-  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+  const bool avx2 = detail::runsAvx2(kernel);
   for (int i = 0; i < count; ++i) {
     // Zero outside the surface (no cyclic wrap: radii beyond N/2 are not aliases).
     const double direction = 2.0 * CV_PI * (first_row + i) / n;
-    detail::LineSamples ray{};
-    ray.source = centred_surface.ptr<float>();
-    ray.stride = static_cast<int>(centred_surface.step1());
-    ray.cols = ray.rows = n;
-    ray.sx0 = ray.sy0 = static_cast<float>(n / 2);
-    ray.dx = static_cast<float>(polar_radius_step_ * std::cos(direction));
-    ray.dy = static_cast<float>(polar_radius_step_ * std::sin(direction));
-    ray.row_weight = 1.0f;
-    ray.count = n;
-    ray.out = out[i];
-    detail::sampleLine(ray, avx2);
+    sampleRay(centred_surface, static_cast<float>(polar_radius_step_ * std::cos(direction)),
+              static_cast<float>(polar_radius_step_ * std::sin(direction)), nullptr, out[i], avx2);
   }
 }
 
@@ -110,7 +110,7 @@ void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::
   const int n = spectrum.rows;
   const int half = n / 2;
   magnitude.create(half + 2, n);
-  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+  const bool avx2 = detail::runsAvx2(kernel);
   // |.| of the half + 1 stored columns of the two spectrum rows a centred row needs.
   std::vector<float> direct(half + 1), mirror(half + 1);
   auto magnitudes = [avx2](const float* complex_values, int count, float* out) {

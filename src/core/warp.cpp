@@ -24,7 +24,7 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
   const float a00 = static_cast<float>(c), a01 = static_cast<float>(-s);
   const float a10 = static_cast<float>(s), a11 = static_cast<float>(c);
   const int stride = static_cast<int>(source.step1());
-  const bool avx2 = kernel == SimdKernel::kAuto && cpuRunsAvx2Kernels();
+  const bool avx2 = detail::runsAvx2(kernel);
   for (int y = 0; y < rows; ++y) {
     const double dy = y - cy;
     // Source point of output (0, y); column x adds x * (a00, a10). Window: taper(y) * taper(x).
