@@ -9,6 +9,7 @@
 #include "oefmt/fft.h"
 #include "oefmt/phase_correlation.h"
 #include "oefmt/config.h"
+#include "oefmt/error.h"
 #include "oefmt/spectra.h"
 
 namespace oefmt {
@@ -113,6 +114,20 @@ TEST(SimdKernels, PolarRowsMatchThePortableLoopOnAPaddedSurface) {
     const double expected = bilinear(surface, n / 2 + radius * std::cos(direction),
                                      n / 2 + radius * std::sin(direction));
     EXPECT_NEAR(fast(at.y, at.x), expected, 1e-4) << at;
+  }
+}
+
+// The unwraps refuse a source of the wrong size with a clear error instead of reading past it.
+TEST(SimdKernels, UnwrapsRefuseSourcesOfTheWrongSize) {
+  RegistrationConfig config;
+  config.size = 64;
+  config.fft_planning = FftPlanning::kEstimate;
+  const SpectralContext context(config);
+  cv::Mat1f out;
+  for (const SimdKernel kernel : {SimdKernel::kAuto, SimdKernel::kPortable}) {
+    EXPECT_THROW(context.logPolar(cv::Mat1f(64, 64, 1.0f), out, kernel), InputError);  // not N/2 + 2 rows
+    EXPECT_THROW(context.logPolar(cv::Mat1f(), out, kernel), InputError);
+    EXPECT_THROW(context.polarRows(cv::Mat1f(32, 64, 1.0f), 0, 3, out, kernel), InputError);
   }
 }
 
