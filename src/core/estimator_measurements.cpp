@@ -119,5 +119,16 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
   return obs;
 }
 
+PairMotion steadierLayerStep(const PairMotion& candidate, const PairMotion& measured,
+                             bool switched_layer, const Reference& reference, double intervals) {
+  const double expected = reference.shift * intervals;
+  if (!switched_layer || !(expected > 0.0) || !(candidate.shift() > 0.0) || !(measured.shift() > 0.0)) {
+    return candidate;
+  }
+  const double candidate_off = std::fabs(std::log(candidate.shift() / expected));
+  const double measured_off = std::fabs(std::log(measured.shift() / expected));
+  return measured_off < candidate_off ? measured : candidate;
+}
+
 }  // namespace detail
 }  // namespace oefmt

@@ -52,5 +52,13 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
                          const EstimatorConfig& config, double shift_per_bin,
                          double log_zoom_per_bin, double intervals, PairMotion& initial);
 
+/// When PMT made the step `candidate` follow another depth layer than the registration's
+/// dominant peak (`measured`), the hypothesis nearer to pair 0-1's speed continued over
+/// `intervals` is kept. A single pair cannot tell a layer switch from a stretch matched to the
+/// wrong layer, and the loop cannot either when pairs 1-2 and 0-2 matched the same wrong layer;
+/// without this one such match rescaled the rest of a flight.
+PairMotion steadierLayerStep(const PairMotion& candidate, const PairMotion& measured,
+                             bool switched_layer, const Reference& reference, double intervals);
+
 }  // namespace detail
 }  // namespace oefmt

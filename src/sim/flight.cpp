@@ -80,9 +80,10 @@ FlightPlan planFlight(const FlightOptions& o) {
     BlockLevel level;
     level.height = heights[l];
     level.incline_deg = l + 1 == heights.size() ? o.incline_deg : 0.0;
-    level.share = 0.7 / heights.size();
+    level.share = o.raised_share / heights.size();
     scene.levels.push_back(level);
   }
+  scene.fill = o.fill;
   scene.cell_size = o.cell_size > 0.0 ? o.cell_size : 0.22 * ground_pixel * k.width;
   scene.texel = o.texel > 0.0 ? o.texel : 0.5 * ground_pixel;
   scene.texture_size = o.texture_size > 0 ? o.texture_size : std::min(4096, 8 * k.width);

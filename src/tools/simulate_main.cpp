@@ -53,6 +53,8 @@ scene:
   --levels H1,H2,...         raised levels' heights [m] (default 0.15 and 0.30 of the altitude)
   --flat                     ground plane only, no raised levels
   --incline DEG              tilt of the last level's terraces (default 6)
+  --raised F                 fraction of the terraces raised, split among the levels (0.7)
+  --fill F                   probability that a cell of a raised terrace has a top (0.6)
   --cell M                   block pitch [m] (default 0.22 of the ground footprint's width at
                              the mean altitude)
   --texel M                  texture resolution [m] (default half a ground pixel at the mean
@@ -153,6 +155,10 @@ Command parse(int argc, char** argv) {
       f.flat = true;
     } else if (arg == "--incline") {
       f.incline_deg = args.number(arg);
+    } else if (arg == "--raised") {
+      f.raised_share = args.number(arg);
+    } else if (arg == "--fill") {
+      f.fill = args.number(arg);
     } else if (arg == "--cell") {
       f.cell_size = args.number(arg);
     } else if (arg == "--texel") {

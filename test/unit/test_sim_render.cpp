@@ -11,6 +11,7 @@
 
 #include "io/temp_dir.h"
 #include "oefmt/dataset.h"
+#include "oefmt/error.h"
 
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
@@ -117,6 +118,25 @@ TEST(SimRender, SeveralDepthsAreInView) {
   const double total = static_cast<double>(frame.layers.total());
   EXPECT_GT(counts[0] / total, 0.3);
   EXPECT_GT((counts[1] + counts[2]) / total, 0.05);
+}
+
+// --raised and --fill: nearly all terraces raised and filled, the roofs take most of the view;
+// shares beyond 1 are refused.
+TEST(SimRender, RaisedShareAndFillSetTheRoofsArea) {
+  FlightOptions options = smallFlight();
+  options.raised_share = 1.0;
+  options.fill = 0.95;
+  const FlightPlan plan = planFlight(options);
+  const Renderer renderer(std::make_shared<const Scene>(plan.scene), plan.camera, 1);
+  const cv::Mat1b layers = renderer.render(plan.poses[0]).layers;
+  const double ground = static_cast<double>(cv::countNonZero(layers == 0)) / layers.total();
+  EXPECT_LT(ground, 0.5);
+  EXPECT_GT(ground, 0.1);  // the gaps between the tops stay in view
+  options.raised_share = 1.5;
+  EXPECT_THROW(planFlight(options), InputError);
+  options.raised_share = 0.7;
+  options.fill = -0.1;
+  EXPECT_THROW(planFlight(options), InputError);
 }
 
 TEST(SimRender, FlatLevelPixelsLieOnThatLevelsTops) {
