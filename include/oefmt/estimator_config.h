@@ -50,6 +50,9 @@ struct TrackingConfig {
   double layer_search = 0.15;
   /// A followed-layer peak must reach this fraction of the translation energy maximum.
   double layer_min_fraction = 0.01;
+  /// A step off steady speed is moved to a translation energy peak at the steady length when
+  /// that peak reaches this fraction of the maximum (see steadyLayerStep).
+  double steady_layer_min_fraction = 0.05;
   /// Consecutive frames that may fail to register before the window restarts from the newest.
   int max_failed_frames = 3;
   /// While frames fail, predict the pose with the last motion (else hold it).

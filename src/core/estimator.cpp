@@ -241,16 +241,14 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) 
   est.matching_ms = msSince(t);
 
   PairMotion initial12;
-  const PairMotion raw12 = est.measured12;
   const PairObservations obs12 =
-      detail::observe(reg12, raw12, est.pmt12, est.pms12, ref, config, shift_per_bin,
+      detail::observe(reg12, est.measured12, est.pmt12, est.pms12, ref, config, shift_per_bin,
                       log_zoom_per_bin, double(gap12) / gap01, initial12);
   est.translation_use12 = obs12.translation_use;
   est.measured12 = initial12;
-  using TranslationUse = PairObservations::TranslationUse;
-  if (!usable02) {
-    return detail::steadierLayerStep(initial12, raw12, obs12.translation_use == TranslationUse::kDirection,
-                                     ref, double(gap12) / gap01);
+  if (!usable02) {  // no loop: the gated measurement
+    return detail::steadyLayerStep(initial12, reg12, ref, config.tracking, shift_per_bin,
+                                   double(gap12) / gap01);
   }
 
   PairMotion initial02;
@@ -266,9 +264,8 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) 
     return initial12;
   }
   if (ref.shift > 0.0) est.lambda_t02 = est.loop.pair02.shift() / ref.shift;
-  const bool switched = obs12.translation_use == TranslationUse::kDirection ||
-                        obs02.translation_use == TranslationUse::kDirection;
-  return detail::steadierLayerStep(est.loop.pair12, raw12, switched, ref, double(gap12) / gap01);
+  return detail::steadyLayerStep(est.loop.pair12, reg12, ref, config.tracking, shift_per_bin,
+                                 double(gap12) / gap01);
 }
 
 void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,

@@ -189,6 +189,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
   all.push_back({"tracking",
                  {number("layer_gate", t.layer_gate), number("layer_search", t.layer_search),
                   number("layer_min_fraction", t.layer_min_fraction),
+                  number("steady_layer_min_fraction", t.steady_layer_min_fraction),
                   integer("max_failed_frames", t.max_failed_frames),
                   boolean("predict_failed_frames", t.predict_failed_frames),
                   number("prediction_sigma", t.prediction_sigma),
@@ -269,6 +270,7 @@ void TrackingConfig::validate() const {
   require(finiteIn(layer_gate, 0.001, 1.0), "layer_gate", "must be in [0.001, 1]");
   require(finiteIn(layer_search, 0.001, 1.0), "layer_search", "must be in [0.001, 1]");
   require(finiteIn(layer_min_fraction, 0.0, 1.0), "layer_min_fraction", "must be in [0, 1]");
+  require(finiteIn(steady_layer_min_fraction, 0.0, 1.0), "steady_layer_min_fraction", "must be in [0, 1]");
   require(max_failed_frames >= 0 && max_failed_frames <= 1000, "max_failed_frames",
           "must be in [0, 1000]");
   require(finiteIn(prediction_sigma, 0.0, 100.0), "prediction_sigma", "must be in [0, 100]");

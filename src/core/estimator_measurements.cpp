@@ -119,15 +119,29 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
   return obs;
 }
 
-PairMotion steadierLayerStep(const PairMotion& candidate, const PairMotion& measured,
-                             bool switched_layer, const Reference& reference, double intervals) {
-  const double expected = reference.shift * intervals;
-  if (!switched_layer || !(expected > 0.0) || !(candidate.shift() > 0.0) || !(measured.shift() > 0.0)) {
+PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
+                           const Reference& reference, const TrackingConfig& tracking,
+                           double shift_per_bin, double intervals) {
+  const double steady = reference.shift * intervals;
+  const double length = candidate.shift();
+  if (!(steady > 0.0) || !(length > 0.0) || !(shift_per_bin > 0.0) ||
+      std::fabs(length - steady) <= tracking.layer_gate * steady) {
     return candidate;
   }
-  const double candidate_off = std::fabs(std::log(candidate.shift() / expected));
-  const double measured_off = std::fabs(std::log(measured.shift() / expected));
-  return measured_off < candidate_off ? measured : candidate;
+  const std::optional<double> bin =
+      peakNear(registration12.translation_energy, steady / shift_per_bin,
+               tracking.layer_search * steady / shift_per_bin, tracking.steady_layer_min_fraction);
+  if (!bin || !(*bin > 0.0)) return candidate;
+  PairMotion step = candidate;
+  const double direction = candidate.direction();
+  const double steady_length = *bin * shift_per_bin;
+  step.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * steady_length;
+  // As for a followed layer's peak in observe(): twice the correlation peak's sigma along.
+  const double across = std::sqrt(std::max(cv::trace(candidate.translation_covariance), 0.0));
+  step.translation_covariance = alongAcrossCovariance(
+      direction, std::max(2.0 * alongTrackSigma(candidate), kMinShiftSigma),
+      std::max(across * steady_length / length, kMinShiftSigma));
+  return step;
 }
 
 }  // namespace detail

@@ -52,13 +52,17 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
                          const EstimatorConfig& config, double shift_per_bin,
                          double log_zoom_per_bin, double intervals, PairMotion& initial);
 
-/// When PMT made the step `candidate` follow another depth layer than the registration's
-/// dominant peak (`measured`), the hypothesis nearer to pair 0-1's speed continued over
-/// `intervals` is kept. A single pair cannot tell a layer switch from a stretch matched to the
-/// wrong layer, and the loop cannot either when pairs 1-2 and 0-2 matched the same wrong layer;
-/// without this one such match rescaled the rest of a flight.
-PairMotion steadierLayerStep(const PairMotion& candidate, const PairMotion& measured,
-                             bool switched_layer, const Reference& reference, double intervals);
+/// The step of pair 1-2 that keeps following one depth layer. `candidate` is the loop's step
+/// (without a loop, the gated measurement). When its length is off steady speed (pair 0-1's
+/// shift continued over `intervals`) by more than tracking.layer_gate and pair 1-2's translation
+/// energy vector has a peak of at least tracking.steady_layer_min_fraction of its maximum within
+/// tracking.layer_search of the steady length, that peak gives the length. A hop to another
+/// layer's peak (the dominant peak's, or a stretch matched to the wrong layer, in one pair or in
+/// both pairs of the loop alike) is far likelier than a speed change by a layer ratio within one
+/// frame interval; a real speed change leaves no peak at the steady length and stands.
+PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
+                           const Reference& reference, const TrackingConfig& tracking,
+                           double shift_per_bin, double intervals);
 
 }  // namespace detail
 }  // namespace oefmt

@@ -2,10 +2,15 @@
 // The estimator's internal decisions on one pair's observations (src/core/estimator_measurements).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 #include "estimator_measurements.h"
 
 namespace oefmt {
 namespace {
+
+constexpr double kShiftPerBin = 1.0;
 
 PairMotion motionAlongX(double shift) {
   PairMotion m;
@@ -22,42 +27,60 @@ detail::Reference referenceOf(double shift) {
   return ref;
 }
 
-// Pair 0-1 moved 92.7 px. A stretch that matched the ground of one energy vector to a higher
-// layer of the other makes the step 1.47 times as long while the dominant peak says 92.6 px:
-// without a loop to confirm the switch, the steadier dominant peak is kept.
-TEST(SteadierLayerStep, AWrongStretchDoesNotRescaleTheFlight) {
-  const PairMotion candidate = motionAlongX(136.3), measured = motionAlongX(92.6);
-  const PairMotion step = detail::steadierLayerStep(candidate, measured, true,
-                                                referenceOf(92.7), 1.0);
-  EXPECT_DOUBLE_EQ(step.shift(), 92.6);
+// Pair 1-2 of a scene whose layers' peaks lie at the given bins with the given heights.
+PairRegistration withPeaks(const std::vector<std::pair<double, double>>& peaks) {
+  PairRegistration r;
+  r.translation_energy.assign(256, 0.0f);
+  for (int j = 0; j < 256; ++j) {
+    for (const auto& [bin, height] : peaks) {
+      r.translation_energy[j] += static_cast<float>(height * std::exp(-0.5 * (j - bin) * (j - bin) / 4.0));
+    }
+  }
+  return r;
 }
 
-// The roofs took over the correlation peak (1.4 times the ground's shift) while PMT followed
-// the ground at steady speed: the switch PMT proposed is kept.
-TEST(SteadierLayerStep, ARoofTakingOverThePeakStillFollowsTheGround) {
-  const PairMotion candidate = motionAlongX(93.0), measured = motionAlongX(129.8);
-  const PairMotion step = detail::steadierLayerStep(candidate, measured, true,
-                                                referenceOf(92.7), 1.0);
-  EXPECT_DOUBLE_EQ(step.shift(), 93.0);
+// Pair 0-1 moved 92.7 px along the ground. The roofs (x1.43) took over pair 1-2's dominant
+// peak and the loop followed them; the ground's peak, 1/12 of theirs, is still at the steady
+// length: the step goes back to it, direction and all else kept.
+TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
+  PairMotion loop = motionAlongX(132.5);
+  loop.translation = {132.5 * std::cos(0.3), 132.5 * std::sin(0.3)};
+  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{92.7, 0.08}, {132.5, 1.0}}),
+                                                  referenceOf(92.7), TrackingConfig(), kShiftPerBin, 1.0);
+  EXPECT_NEAR(step.shift(), 92.7, 0.1);
+  EXPECT_NEAR(step.direction(), 0.3, 1e-9);
+  EXPECT_TRUE(step.finite());
+  EXPECT_GE(cv::determinant(step.translation_covariance), 0.0);
+}
+
+// A real speed change (x1.6, one layer) leaves no peak at the steady length: it stands.
+TEST(SteadyLayerStep, ASpeedChangeStands) {
+  const PairMotion loop = motionAlongX(148.3);
+  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{148.3, 1.0}}), referenceOf(92.7),
+                                                  TrackingConfig(), kShiftPerBin, 1.0);
+  EXPECT_DOUBLE_EQ(step.shift(), 148.3);
 }
 
 // Pair 0-2 spans two of pair 0-1's intervals: steady speed means twice its shift.
-TEST(SteadierLayerStep, SteadySpeedScalesWithTheFrameIntervals) {
-  const PairMotion candidate = motionAlongX(185.0), measured = motionAlongX(130.0);
-  const PairMotion step = detail::steadierLayerStep(candidate, measured, true,
-                                                referenceOf(92.7), 2.0);
-  EXPECT_DOUBLE_EQ(step.shift(), 185.0);
+TEST(SteadyLayerStep, SteadySpeedScalesWithTheFrameIntervals) {
+  const PairMotion loop = motionAlongX(265.0);
+  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{185.4, 0.2}, {265.0, 1.0}}),
+                                                  referenceOf(92.7), TrackingConfig(), kShiftPerBin, 2.0);
+  EXPECT_NEAR(step.shift(), 185.4, 0.1);
 }
 
-// Without a proposed switch, or without a reference length, the candidate step stands.
-TEST(SteadierLayerStep, NoSwitchOrNoReferenceKeepsTheGatedStep) {
-  const PairMotion candidate = motionAlongX(136.3), measured = motionAlongX(92.6);
-  EXPECT_DOUBLE_EQ(detail::steadierLayerStep(candidate, measured, false,
-                                         referenceOf(92.7), 1.0).shift(), 136.3);
-  EXPECT_DOUBLE_EQ(detail::steadierLayerStep(candidate, measured, true,
-                                         referenceOf(0.0), 1.0).shift(), 136.3);
-  EXPECT_DOUBLE_EQ(detail::steadierLayerStep(candidate, motionAlongX(0.0), true,
-                                         referenceOf(92.7), 1.0).shift(), 136.3);
+// A step at steady speed, a peak too small to be a layer, or no reference: the step stands.
+TEST(SteadyLayerStep, StepsAtSteadySpeedOrWithoutEvidenceStand) {
+  TrackingConfig tracking;
+  EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(94.0), withPeaks({{92.7, 1.0}}), referenceOf(92.7),
+                                           tracking, kShiftPerBin, 1.0).shift(), 94.0);
+  EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.01}, {132.5, 1.0}}),
+                                           referenceOf(92.7), tracking, kShiftPerBin, 1.0).shift(), 132.5);
+  EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.5}, {132.5, 1.0}}),
+                                           referenceOf(0.0), tracking, kShiftPerBin, 1.0).shift(), 132.5);
+  tracking.steady_layer_min_fraction = 1.0;  // only the largest peak would do
+  EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.5}, {132.5, 1.0}}),
+                                           referenceOf(92.7), tracking, kShiftPerBin, 1.0).shift(), 132.5);
 }
 
 }  // namespace
