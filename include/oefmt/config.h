@@ -17,6 +17,9 @@ struct RegistrationConfig {
   bool resolve_half_turn = true;          ///< tell theta from theta + 180 deg by the shift peak
   double min_texture = 1e-3;              ///< grey std below which a frame counts as textureless
   double min_confidence = 0.15;           ///< results below this confidence are flagged low
+  /// Rotation/zoom peaks tried, highest first, while the registration stays below
+  /// min_confidence (1 = only the highest).
+  int rotation_zoom_candidates = 5;
   FftPlanning fft_planning = FftPlanning::kMeasure;  ///< FFTW planning effort (once per size)
 
   /// Throws InputError naming the first invalid field.

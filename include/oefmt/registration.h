@@ -42,6 +42,7 @@ struct PairRegistration {
   double rotation_zoom_peak = 0.0;  ///< height of the rotation/zoom correlation peak (0..1)
   double translation_peak = 0.0;    ///< height of the translation correlation peak (0..1)
   double confidence = 0.0;          ///< 0 (unusable) .. 1, from both peak-to-sidelobe ratios
+  int rotation_zoom_candidate = 0;  ///< which rotation/zoom peak registered (0 = the highest)
   bool half_turn = false;           ///< the 180-degree alternative won
 
   bool usable() const { return status == RegistrationStatus::kOk; }
@@ -81,9 +82,15 @@ class Registrar {
   double shiftPerBin() const { return context_->polarRadiusStep(); }
 
  private:
+  // Rotation, zoom, translation and confidence with the highest rotation/zoom peak outside the
+  // `excluded` ones (peaks tried before); `peak` receives the one used.
+  void registerOnce(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
+                    const std::vector<cv::Point>& excluded, PairRegistration& result, cv::Point& peak,
+                    RegistrationSurfaces* surfaces);
   // Each returns the peak-to-sidelobe ratio of its correlation surface.
   double registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
-                            RegistrationMethod method, PairRegistration& result);
+                              RegistrationMethod method, const std::vector<cv::Point>& excluded,
+                              PairRegistration& result, cv::Point& peak);
   double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
                              RegistrationMethod method, PairRegistration& result);
 

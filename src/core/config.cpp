@@ -29,6 +29,8 @@ void RegistrationConfig::validate() const {
   require(std::isfinite(min_texture) && min_texture >= 0.0, "min_texture", "must be >= 0");
   require(std::isfinite(min_confidence) && min_confidence >= 0.0 && min_confidence <= 1.0,
           "min_confidence", "must be in [0, 1]");
+  require(rotation_zoom_candidates >= 1 && rotation_zoom_candidates <= 10, "rotation_zoom_candidates",
+          "must be in [1, 10]");
 }
 
 }  // namespace oefmt

@@ -133,6 +133,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   number("energy_smoothing_sigma", r.energy_smoothing_sigma),
                   boolean("resolve_half_turn", r.resolve_half_turn),
                   number("min_texture", r.min_texture), number("min_confidence", r.min_confidence),
+                  integer("rotation_zoom_candidates", r.rotation_zoom_candidates),
                   {"fft_planning",
                    [&r](const YamlNode& n, const std::string& k) {
                      const std::string v = readString(n, k);

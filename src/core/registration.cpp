@@ -29,6 +29,19 @@ constexpr double kRotationZoomPsrGood = 20.0;
 constexpr int kPolarBandHalfWidth = 16;
 constexpr int kEnergyRowBand = 12;
 
+// Half size of the window cleared around a rotation/zoom peak already tried [bins]: wider than
+// the log-polar peak, narrower than a quarter turn's distance.
+constexpr int kTriedPeakRadius = 6;
+
+// Zeroes the (2 radius + 1)^2 window around p, rows and columns cyclic (both wrap on the
+// rotation/zoom surface).
+void clearAround(cv::Mat1f& surface, const cv::Point& p, int radius) {
+  for (int dr = -radius; dr <= radius; ++dr) {
+    float* row = surface[((p.y + dr) % surface.rows + surface.rows) % surface.rows];
+    for (int dc = -radius; dc <= radius; ++dc) row[((p.x + dc) % surface.cols + surface.cols) % surface.cols] = 0.0f;
+  }
+}
+
 double wrapAngle(double a) {
   a = std::fmod(a + CV_PI, 2.0 * CV_PI);
   if (a <= 0.0) a += 2.0 * CV_PI;
@@ -113,7 +126,33 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     result.shift_sigma = n;
     return result;
   }
-  const double psr_rotation_zoom = registerRotationZoom(older, newer, method, result);
+  // A lattice of blocks or a repetitive texture can give a wrong rotation/zoom peak (a quarter
+  // turn, a wrong zoom) the highest value; the translation surface then shows no peak. The next
+  // highest peaks are tried until one registers.
+  std::vector<cv::Point> tried;
+  const int candidates = context_->config().rotation_zoom_candidates;
+  for (int attempt = 0; attempt < candidates; ++attempt) {
+    PairRegistration trial;
+    RegistrationSurfaces trial_surfaces;
+    cv::Point peak;
+    registerOnce(older, newer, method, tried, trial, peak, surfaces ? &trial_surfaces : nullptr);
+    if (attempt == 0 || trial.confidence > result.confidence) {
+      result = std::move(trial);
+      result.rotation_zoom_candidate = attempt;
+      if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+    }
+    if (result.status == RegistrationStatus::kOk) break;
+    tried.push_back(peak);
+  }
+  return result;
+}
+
+void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
+                             RegistrationMethod method, const std::vector<cv::Point>& excluded,
+                             PairRegistration& result, cv::Point& peak,
+                             RegistrationSurfaces* surfaces) {
+  const int n = context_->size();
+  const double psr_rotation_zoom = registerRotationZoom(older, newer, method, excluded, result, peak);
   if (surfaces != nullptr) surfaces->rotation_zoom = surface_.clone();
   const double psr_translation = registerTranslation(older, newer, method, result);
   if (surfaces != nullptr) {
@@ -128,11 +167,11 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
-  return result;
 }
 
 double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
-                                     RegistrationMethod method, PairRegistration& result) {
+                                       RegistrationMethod method, const std::vector<cv::Point>& excluded,
+                                       PairRegistration& result, cv::Point& peak_at) {
   const int n = context_->size();
   centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
   // The full surface: a coarse low-resolution search for the rotation row (to invert only a
@@ -141,8 +180,10 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
   // cross_power_.
   context_->fft().inverseInPlace(cross_power_);
   surface_ = context_->fft().realView(cross_power_);
+  for (const cv::Point& p : excluded) clearAround(surface_, p, kTriedPeakRadius);
   SurfaceStats stats;
   const SurfacePeak peak = findPeak(surface_, true, &stats, PeakShape::kBroadened);
+  peak_at = cv::Point(peak.col, peak.row);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
   result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
