@@ -2,6 +2,7 @@
 // Spectral registration of an image pair: rotation, zoom, translation and their energy vectors.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -80,6 +81,9 @@ class Registrar {
   double logZoomPerBin() const;
   /// Pixels of shift per translation-energy bin.
   double shiftPerBin() const { return context_->polarRadiusStep(); }
+  /// Rotation/zoom peaks this Registrar tries (default: the configuration's
+  /// rotation_zoom_candidates); clamped to >= 1.
+  void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
 
  private:
   // Rotation, zoom, translation and confidence with the highest rotation/zoom peak outside the
@@ -102,6 +106,7 @@ class Registrar {
   cv::Mat1f small_surface_, polar_;
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;
+  int rotation_zoom_candidates_;
 };
 
 }  // namespace oefmt

@@ -57,7 +57,11 @@ struct Estimator::State {
         registrar02(registrar.sharedContext()),
         optimizer(c.optimizer),
         integrator(c.initialAltitude(), c.effectiveFx()),
-        multi_zoom(registrar.sharedContext(), c.efmt) {}
+        multi_zoom(registrar.sharedContext(), c.efmt) {
+    // A pair 0-2 that does not register only costs this frame its loop: the further rotation/zoom
+    // candidates (up to 4 more registrations, on the tail latency) are kept for pair 1-2.
+    registrar02.setRotationZoomCandidates(1);
+  }
 
   void clear() {
     f0.reset();

@@ -96,7 +96,9 @@ Registrar::Registrar(const RegistrationConfig& config)
     : Registrar(std::make_shared<const SpectralContext>(config)) {}
 
 Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
-    : context_(std::move(context)), builder_(context_) {}
+    : context_(std::move(context)),
+      builder_(context_),
+      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {}
 
 FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {
   return builder_.build(image, order);
@@ -130,8 +132,7 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   // turn, a wrong zoom) the highest value; the translation surface then shows no peak. The next
   // highest peaks are tried until one registers.
   std::vector<cv::Point> tried;
-  const int candidates = context_->config().rotation_zoom_candidates;
-  for (int attempt = 0; attempt < candidates; ++attempt) {
+  for (int attempt = 0; attempt < rotation_zoom_candidates_; ++attempt) {
     PairRegistration trial;
     RegistrationSurfaces trial_surfaces;
     cv::Point peak;
