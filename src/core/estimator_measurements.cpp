@@ -120,12 +120,13 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 }
 
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
-                           const Reference& reference, const TrackingConfig& tracking,
+                           const Reference& reference, const EstimatorConfig& config,
                            double shift_per_bin, double intervals) {
+  const TrackingConfig& tracking = config.tracking;
   const double steady = reference.shift * intervals;
   const double length = candidate.shift();
-  if (!(steady > 0.0) || !(length > 0.0) || !(shift_per_bin > 0.0) ||
-      std::fabs(length - steady) <= tracking.layer_gate * steady) {
+  if (!(shift_per_bin > 0.0) || !(steady > 4.0 * config.matching.skip_bins * shift_per_bin) ||
+      !(length > 0.0) || std::fabs(length - steady) <= tracking.layer_gate * steady) {
     return candidate;
   }
   const std::optional<double> bin =

@@ -59,9 +59,11 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 /// tracking.layer_search of the steady length, that peak gives the length. A hop to another
 /// layer's peak (the dominant peak's, or a stretch matched to the wrong layer, in one pair or in
 /// both pairs of the loop alike) is far likelier than a speed change by a layer ratio within one
-/// frame interval; a real speed change leaves no peak at the steady length and stands.
+/// frame interval; a real speed change leaves no peak at the steady length and stands. Slow
+/// motion (a steady length within 4 x matching.skip_bins, where a static pattern's no-motion
+/// peak lies) is left alone too.
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
-                           const Reference& reference, const TrackingConfig& tracking,
+                           const Reference& reference, const EstimatorConfig& config,
                            double shift_per_bin, double intervals);
 
 }  // namespace detail

@@ -46,7 +46,7 @@ TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
   PairMotion loop = motionAlongX(132.5);
   loop.translation = {132.5 * std::cos(0.3), 132.5 * std::sin(0.3)};
   const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{92.7, 0.08}, {132.5, 1.0}}),
-                                                  referenceOf(92.7), TrackingConfig(), kShiftPerBin, 1.0);
+                                                  referenceOf(92.7), EstimatorConfig(), kShiftPerBin, 1.0);
   EXPECT_NEAR(step.shift(), 92.7, 0.1);
   EXPECT_NEAR(step.direction(), 0.3, 1e-9);
   EXPECT_TRUE(step.finite());
@@ -57,7 +57,7 @@ TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
 TEST(SteadyLayerStep, ASpeedChangeStands) {
   const PairMotion loop = motionAlongX(148.3);
   const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{148.3, 1.0}}), referenceOf(92.7),
-                                                  TrackingConfig(), kShiftPerBin, 1.0);
+                                                  EstimatorConfig(), kShiftPerBin, 1.0);
   EXPECT_DOUBLE_EQ(step.shift(), 148.3);
 }
 
@@ -65,22 +65,30 @@ TEST(SteadyLayerStep, ASpeedChangeStands) {
 TEST(SteadyLayerStep, SteadySpeedScalesWithTheFrameIntervals) {
   const PairMotion loop = motionAlongX(265.0);
   const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{185.4, 0.2}, {265.0, 1.0}}),
-                                                  referenceOf(92.7), TrackingConfig(), kShiftPerBin, 2.0);
+                                                  referenceOf(92.7), EstimatorConfig(), kShiftPerBin, 2.0);
   EXPECT_NEAR(step.shift(), 185.4, 0.1);
 }
 
 // A step at steady speed, a peak too small to be a layer, or no reference: the step stands.
 TEST(SteadyLayerStep, StepsAtSteadySpeedOrWithoutEvidenceStand) {
-  TrackingConfig tracking;
+  EstimatorConfig config;
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(94.0), withPeaks({{92.7, 1.0}}), referenceOf(92.7),
-                                           tracking, kShiftPerBin, 1.0).shift(), 94.0);
+                                           config, kShiftPerBin, 1.0).shift(), 94.0);
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.01}, {132.5, 1.0}}),
-                                           referenceOf(92.7), tracking, kShiftPerBin, 1.0).shift(), 132.5);
+                                           referenceOf(92.7), config, kShiftPerBin, 1.0).shift(), 132.5);
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.5}, {132.5, 1.0}}),
-                                           referenceOf(0.0), tracking, kShiftPerBin, 1.0).shift(), 132.5);
-  tracking.steady_layer_min_fraction = 1.0;  // only the largest peak would do
+                                           referenceOf(0.0), config, kShiftPerBin, 1.0).shift(), 132.5);
+  config.tracking.steady_layer_min_fraction = 1.0;  // only the largest peak would do
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.5}, {132.5, 1.0}}),
-                                           referenceOf(92.7), tracking, kShiftPerBin, 1.0).shift(), 132.5);
+                                           referenceOf(92.7), config, kShiftPerBin, 1.0).shift(), 132.5);
+}
+
+// Slow motion: a steady length inside the no-motion zone (4 x skip_bins = 20 bins here), where a
+// static pattern peaks, does not hold back a speed-up.
+TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
+  const PairMotion step = detail::steadyLayerStep(motionAlongX(12.0), withPeaks({{6.0, 0.5}, {12.0, 1.0}}),
+                                                  referenceOf(6.0), EstimatorConfig(), kShiftPerBin, 1.0);
+  EXPECT_DOUBLE_EQ(step.shift(), 12.0);
 }
 
 }  // namespace
