@@ -33,7 +33,11 @@ void addValueNoise(cv::Mat1f& out, cv::RNG& rng, double feature_px) {
 void addCells(cv::Mat1f& out, cv::RNG& rng, double feature_px) {
   const int count = static_cast<int>(out.total() / (feature_px * feature_px) * 3.0) + 1;
   for (int i = 0; i < count; ++i) {
-    const cv::Point centre(rng.uniform(0, out.cols), rng.uniform(0, out.rows));
+    // One draw per statement: the order in which a call's arguments are evaluated is
+    // unspecified (g++ drew y first, clang++ x), so the same seed gave other textures.
+    const int y = rng.uniform(0, out.rows);
+    const int x = rng.uniform(0, out.cols);
+    const cv::Point centre(x, y);
     const double value = rng.uniform(-1.5, 1.5);
     const int extent = std::max(2, static_cast<int>(rng.uniform(0.1, 0.6) * feature_px));
     if (rng.uniform(0, 2) == 0) {
