@@ -86,23 +86,23 @@ class Registrar {
   void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
 
  private:
-  // Rotation, zoom, translation and confidence with the highest rotation/zoom peak outside the
-  // `excluded` ones (peaks tried before); `peak` receives the one used.
+  // The rotation/zoom correlation surface of the pair, into rotation_zoom_surface_.
+  void correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer);
+  // Rotation, zoom, translation and confidence with the highest peak left on the rotation/zoom
+  // surface; `peak` receives it.
   void registerOnce(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
-                    const std::vector<cv::Point>& excluded, PairRegistration& result, cv::Point& peak,
-                    RegistrationSurfaces* surfaces);
+                    PairRegistration& result, cv::Point& peak, RegistrationSurfaces* surfaces);
   // Each returns the peak-to-sidelobe ratio of its correlation surface.
-  double registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
-                              RegistrationMethod method, const std::vector<cv::Point>& excluded,
-                              PairRegistration& result, cv::Point& peak);
+  double registerRotationZoom(RegistrationMethod method, PairRegistration& result, cv::Point& peak);
   double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
                              RegistrationMethod method, PairRegistration& result);
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
   // Scratch, reused across calls.
-  cv::Mat2f cross_power_, small_spectrum_;
-  cv::Mat1f surface_;  // the last correlation surface: a view of cross_power_ (in-place FFT)
+  cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
+  cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)
+  cv::Mat1f rotation_zoom_surface_;  // a view of rotation_zoom_power_
   cv::Mat1f small_surface_, polar_;
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;

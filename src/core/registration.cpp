@@ -130,31 +130,31 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   }
   // A lattice of blocks or a repetitive texture can give a wrong rotation/zoom peak (a quarter
   // turn, a wrong zoom) the highest value; the translation surface then shows no peak. The next
-  // highest peaks are tried until one registers.
-  std::vector<cv::Point> tried;
+  // highest peaks are tried until one registers: the surface is computed once, and each
+  // candidate clears the window around the one before.
+  correlateRotationZoom(older, newer);
+  cv::Point peak;
   for (int attempt = 0; attempt < rotation_zoom_candidates_; ++attempt) {
+    if (attempt > 0) clearAround(rotation_zoom_surface_, peak, kTriedPeakRadius);
     PairRegistration trial;
     RegistrationSurfaces trial_surfaces;
-    cv::Point peak;
-    registerOnce(older, newer, method, tried, trial, peak, surfaces ? &trial_surfaces : nullptr);
+    registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr);
     if (attempt == 0 || trial.confidence > result.confidence) {
       result = std::move(trial);
       result.rotation_zoom_candidate = attempt;
       if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
     }
     if (result.status == RegistrationStatus::kOk) break;
-    tried.push_back(peak);
   }
   return result;
 }
 
 void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
-                             RegistrationMethod method, const std::vector<cv::Point>& excluded,
-                             PairRegistration& result, cv::Point& peak,
+                             RegistrationMethod method, PairRegistration& result, cv::Point& peak,
                              RegistrationSurfaces* surfaces) {
   const int n = context_->size();
-  const double psr_rotation_zoom = registerRotationZoom(older, newer, method, excluded, result, peak);
-  if (surfaces != nullptr) surfaces->rotation_zoom = surface_.clone();
+  const double psr_rotation_zoom = registerRotationZoom(method, result, peak);
+  if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
   const double psr_translation = registerTranslation(older, newer, method, result);
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
@@ -170,20 +170,23 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
                       : RegistrationStatus::kLowConfidence;
 }
 
-double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpectra& newer,
-                                       RegistrationMethod method, const std::vector<cv::Point>& excluded,
-                                       PairRegistration& result, cv::Point& peak_at) {
-  const int n = context_->size();
-  centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, cross_power_);
+void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer) {
+  centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, rotation_zoom_power_);
   // The full surface: a coarse low-resolution search for the rotation row (to invert only a
   // band of rows) picked wrong rows on simulated flights, where much of the log-polar
   // correlation's energy sits at high frequencies. In place: the surface is a view of
-  // cross_power_.
-  context_->fft().inverseInPlace(cross_power_);
-  surface_ = context_->fft().realView(cross_power_);
-  for (const cv::Point& p : excluded) clearAround(surface_, p, kTriedPeakRadius);
+  // rotation_zoom_power_ (its own buffer, so that the translation leaves it for the next
+  // candidate).
+  context_->fft().inverseInPlace(rotation_zoom_power_);
+  rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
+}
+
+double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistration& result,
+                                       cv::Point& peak_at) {
+  const int n = context_->size();
+  const cv::Mat1f& surface = rotation_zoom_surface_;
   SurfaceStats stats;
-  const SurfacePeak peak = findPeak(surface_, true, &stats, PeakShape::kBroadened);
+  const SurfacePeak peak = findPeak(surface, true, &stats, PeakShape::kBroadened);
   peak_at = cv::Point(peak.col, peak.row);
   const double log_zoom_per_bin = logZoomPerBin();
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
@@ -195,16 +198,16 @@ double Registrar::registerRotationZoom(const FrameSpectra& older, const FrameSpe
     EnergyVectorOptions options = energyVectorOptions(context_->config());
     options.cyclic_cols = true;
     options.row_band = kEnergyRowBand;
-    EnergyVector zoom_vector = extractEnergyVector(surface_, peak, options);
+    EnergyVector zoom_vector = extractEnergyVector(surface, peak, options);
     result.rotation_sigma = zoom_vector.row_sigma * CV_PI / n;
     result.log_zoom_sigma = zoom_vector.col_sigma * log_zoom_per_bin;
     result.zoom_energy = std::move(zoom_vector.values);
   } else {
-    const cv::Point2d widths = peakWidths(surface_, peak, true);
+    const cv::Point2d widths = peakWidths(surface, peak, true);
     result.rotation_sigma = widths.y * CV_PI / n;
     result.log_zoom_sigma = widths.x * log_zoom_per_bin;
   }
-  return peakToSidelobeRatio(surface_, peak, stats);
+  return peakToSidelobeRatio(surface, peak, stats);
 }
 
 double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
