@@ -14,6 +14,15 @@ constexpr double kMinLogZoomSigma = 1e-5;
 
 double finiteOr(double v, double fallback) { return std::isfinite(v) ? v : fallback; }
 
+// `motion` moved to `length` along its own direction, with 1-sigmas along and across it.
+PairMotion withLength(const PairMotion& motion, double length, double along, double across) {
+  PairMotion out = motion;
+  const double direction = motion.direction();
+  out.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
+  out.translation_covariance = alongAcrossCovariance(direction, along, across);
+  return out;
+}
+
 }  // namespace
 
 PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
@@ -111,11 +120,8 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
     length_sigma = 2.0 * alongTrackSigma(measured);
     obs.shift.push_back({length, length_sigma});
   }
-  const double direction = measured.direction();
-  initial.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
-  initial.translation_covariance =
-      alongAcrossCovariance(direction, std::max(length_sigma, kMinShiftSigma),
-                            std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0)));
+  initial = withLength(measured, length, std::max(length_sigma, kMinShiftSigma),
+                       std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0)));
   return obs;
 }
 
@@ -133,16 +139,11 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
       peakNear(registration12.translation_energy, steady / shift_per_bin,
                tracking.layer_search * steady / shift_per_bin, tracking.steady_layer_min_fraction);
   if (!bin || !(*bin > 0.0)) return candidate;
-  PairMotion step = candidate;
-  const double direction = candidate.direction();
   const double steady_length = *bin * shift_per_bin;
-  step.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * steady_length;
   // As for a followed layer's peak in observe(): twice the correlation peak's sigma along.
   const double across = std::sqrt(std::max(cv::trace(candidate.translation_covariance), 0.0));
-  step.translation_covariance = alongAcrossCovariance(
-      direction, std::max(2.0 * alongTrackSigma(candidate), kMinShiftSigma),
-      std::max(across * steady_length / length, kMinShiftSigma));
-  return step;
+  return withLength(candidate, steady_length, std::max(2.0 * alongTrackSigma(candidate), kMinShiftSigma),
+                    std::max(across * steady_length / length, kMinShiftSigma));
 }
 
 }  // namespace detail
