@@ -114,6 +114,11 @@ TEST(EstimatorConfig, ErrorsNameTheKey) {
             std::string::npos);
   EXPECT_NE(errorOf("%YAML:1.0\nmatching:\n  shift_step: abc\n").find("matching.shift_step"),
             std::string::npos);
+  // The parameters added for dense multi-depth scenes: out-of-range values are refused by name.
+  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  rotation_zoom_candidates: 0\n").find("'rotation_zoom_candidates'"),
+            std::string::npos);
+  EXPECT_NE(errorOf("%YAML:1.0\ntracking:\n  steady_layer_min_fraction: 1.5\n").find("'steady_layer_min_fraction'"),
+            std::string::npos);
   // A number with a unit after it, and one beyond float range (strtod: ERANGE).
   EXPECT_NE(errorOf("%YAML:1.0\naltitude: 12m\n").find("'altitude'"), std::string::npos);
   EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  min_texture: 1e-400\n").find("registration.min_texture"),
