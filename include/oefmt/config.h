@@ -26,4 +26,8 @@ struct RegistrationConfig {
   void validate() const;
 };
 
+/// Every field equal (a new field must be added to the comparison in config.cpp).
+bool operator==(const RegistrationConfig& a, const RegistrationConfig& b);
+inline bool operator!=(const RegistrationConfig& a, const RegistrationConfig& b) { return !(a == b); }
+
 }  // namespace oefmt

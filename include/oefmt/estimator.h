@@ -91,6 +91,10 @@ class Estimator {
  public:
   /// Throws InputError if the configuration is invalid.
   explicit Estimator(const EstimatorConfig& config);
+  /// The same, sharing an existing context (its FFT plans and tables) so that frames can be
+  /// analysed ahead on another thread (see push(FrameSpectra, double)). Throws InputError if the
+  /// context was made for other registration parameters than config.registration.
+  Estimator(const EstimatorConfig& config, std::shared_ptr<const SpectralContext> context);
   ~Estimator();
   Estimator(const Estimator&) = delete;
   Estimator& operator=(const Estimator&) = delete;
@@ -102,6 +106,12 @@ class Estimator {
                                ChannelOrder order = ChannelOrder::kBgr);
   /// The same for an already prepared registration.size x registration.size image.
   std::optional<Estimate> push(const PreparedImage& image, double stamp);
+  /// The same for a frame already analysed by a SpectraBuilder on spectralContext(), e.g. on a
+  /// reader thread while this one registers the previous frame. Throws InputError if the
+  /// spectra are empty or of another size.
+  std::optional<Estimate> push(FrameSpectra spectra, double stamp);
+  /// The per-size tables and FFT plans frames are analysed with; shareable between threads.
+  std::shared_ptr<const SpectralContext> spectralContext() const;
 
   /// Forgets every frame; the next frame is the new origin.
   void reset();

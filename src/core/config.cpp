@@ -33,4 +33,15 @@ void RegistrationConfig::validate() const {
           "must be in [1, 10]");
 }
 
+bool operator==(const RegistrationConfig& a, const RegistrationConfig& b) {
+  return a.size == b.size && a.taper_fraction == b.taper_fraction &&
+         a.logpolar_radius_fraction == b.logpolar_radius_fraction &&
+         a.polar_radius_fraction == b.polar_radius_fraction && a.block_radius == b.block_radius &&
+         a.energy_smoothing_sigma == b.energy_smoothing_sigma &&
+         a.resolve_half_turn == b.resolve_half_turn && a.min_texture == b.min_texture &&
+         a.min_confidence == b.min_confidence &&
+         a.rotation_zoom_candidates == b.rotation_zoom_candidates &&
+         a.fft_planning == b.fft_planning;
+}
+
 }  // namespace oefmt

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <future>
 #include <limits>
+#include <string>
 #include <utility>
 
 #include "estimator_measurements.h"
+#include "oefmt/error.h"
 #include "oefmt/multi_zoom.h"
 
 namespace oefmt {
@@ -51,9 +53,9 @@ const char* toString(TrackingState state) {
 
 // The window, the previous pair and the per-size machinery; one method per stage of a frame.
 struct Estimator::State {
-  explicit State(const EstimatorConfig& c)
+  State(const EstimatorConfig& c, std::shared_ptr<const SpectralContext> context)
       : config(c),
-        registrar(c.registration),
+        registrar(std::move(context)),
         registrar02(registrar.sharedContext()),
         optimizer(c.optimizer),
         integrator(c.initialAltitude(), c.effectiveFx()),
@@ -298,7 +300,20 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
 
 Estimator::Estimator(const EstimatorConfig& config) : config_(config) {
   config_.validate();
-  state_ = std::make_unique<State>(config_);
+  state_ = std::make_unique<State>(config_, std::make_shared<const SpectralContext>(config_.registration));
+}
+
+Estimator::Estimator(const EstimatorConfig& config, std::shared_ptr<const SpectralContext> context)
+    : config_(config) {
+  config_.validate();
+  if (!context || context->config() != config_.registration) {
+    throw InputError("Estimator: the spectral context was made for other registration parameters");
+  }
+  state_ = std::make_unique<State>(config_, std::move(context));
+}
+
+std::shared_ptr<const SpectralContext> Estimator::spectralContext() const {
+  return state_->registrar.sharedContext();
 }
 
 Estimator::~Estimator() = default;
@@ -324,6 +339,16 @@ std::optional<Estimate> Estimator::push(const PreparedImage& image, double stamp
   const Clock::time_point start = Clock::now();
   FrameSpectra spectra = state_->registrar.analyse(image);
   return process(std::move(spectra), stamp, msSince(start));
+}
+
+std::optional<Estimate> Estimator::push(FrameSpectra spectra, double stamp) {
+  const int n = config_.registration.size;
+  if (spectra.empty() || spectra.grey.rows != n || spectra.grey.cols != n ||
+      spectra.spectrum.rows != n || spectra.log_polar_spectrum.rows != n) {
+    throw InputError("Estimator: the frame's spectra are empty or not of size " + std::to_string(n));
+  }
+  if (!std::isfinite(stamp) || stamp < state_->last_stamp) return std::nullopt;
+  return process(std::move(spectra), stamp, 0.0);
 }
 
 std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, double prepare_ms) {

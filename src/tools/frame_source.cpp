@@ -3,6 +3,7 @@
 
 #include <utility>
 
+#include "oefmt/error.h"
 #include "oefmt/ros/bag_io.h"
 
 namespace oefmt {
@@ -74,8 +75,9 @@ std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string&
   return std::make_unique<BagSource>(path, image_topic, camera_info_topic);
 }
 
-PrefetchingSource::PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth)
-    : source_(std::move(source)), depth_(depth == 0 ? 1 : depth) {
+PrefetchingSource::PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth,
+                                     Analyse analyse)
+    : source_(std::move(source)), depth_(depth == 0 ? 1 : depth), analyse_(std::move(analyse)) {
   thread_ = std::thread(&PrefetchingSource::run, this);
 }
 
@@ -95,6 +97,15 @@ void PrefetchingSource::run() {
     std::exception_ptr error;
     try {
       more = source_->next(frame);
+      if (more) frame.image_size = frame.image.size();
+      if (more && analyse_) {
+        try {
+          frame.spectra = analyse_(frame.image);
+        } catch (const InputError& e) {
+          throw InputError(frame.name + ": " + e.what());  // which frame, for the user
+        }
+        frame.image.release();
+      }
     } catch (...) {
       error = std::current_exception();
     }

@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Frames for oefmt_offline from a dataset folder or a bag, decoded on a background thread so
-// that PNG/JPEG decoding overlaps the estimation (a bounded queue: memory stays flat).
+// Frames for oefmt_offline from a dataset folder or a bag, decoded (and optionally analysed) on
+// a background thread so that decoding and the frame's FFTs overlap the estimation of the
+// previous frame (a bounded queue: memory stays flat).
 #pragma once
 
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -15,13 +17,16 @@
 #include <opencv2/core.hpp>
 
 #include "oefmt/dataset.h"
+#include "oefmt/spectra.h"
 
 namespace oefmt {
 
 struct SourceFrame {
   std::size_t index = 0;
   double stamp = 0.0;    ///< TUM time: frame index for folders, header stamp [s] for bags
-  cv::Mat image;
+  cv::Mat image;         ///< as decoded; released once `spectra` is made
+  cv::Size image_size;   ///< of the decoded image (kept when the image is released)
+  FrameSpectra spectra;  ///< made by PrefetchingSource's `analyse`, when it has one
   std::string name;      ///< file name or "bag message k"
 };
 
@@ -40,10 +45,13 @@ std::unique_ptr<FrameSource> openFolder(const std::string& directory);
 std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string& image_topic,
                                      const std::string& camera_info_topic);
 
-/// Reads ahead from a source on its own thread, at most `depth` frames.
+/// Reads ahead from a source on its own thread, at most `depth` frames. With `analyse`, each
+/// frame's spectra are made on that thread too (and the decoded image released).
 class PrefetchingSource {
  public:
-  PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth = 4);
+  using Analyse = std::function<FrameSpectra(const cv::Mat& image)>;
+  PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth = 4,
+                    Analyse analyse = nullptr);
   ~PrefetchingSource();
   PrefetchingSource(const PrefetchingSource&) = delete;
   PrefetchingSource& operator=(const PrefetchingSource&) = delete;
@@ -57,6 +65,7 @@ class PrefetchingSource {
 
   std::unique_ptr<FrameSource> source_;
   std::size_t depth_;
+  Analyse analyse_;
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<SourceFrame> queue_;

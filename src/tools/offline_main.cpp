@@ -23,6 +23,7 @@
 #include "oefmt/image_prep.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/sim/progress.h"
+#include "oefmt/spectra.h"
 #include "oefmt/trajectory.h"
 
 namespace {
@@ -155,8 +156,16 @@ int main(int argc, char** argv) {
     oefmt::Intrinsics intrinsics = opened->intrinsics();
     if (options.fx > 0.0) intrinsics.fx = intrinsics.fy = options.fx;
     const std::string source_text = opened->describe();
-    // Two frames ahead keep the decoder busy while the estimator runs; more only costs memory.
-    oefmt::PrefetchingSource source(std::move(opened), 2);
+    // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
+    // one registers the previous frame. One frame queued (another in the making) keeps it busy;
+    // each more costs the 3 MB of a frame's spectra.
+    config.validate();
+    const auto context = std::make_shared<const oefmt::SpectralContext>(config.registration);
+    oefmt::PrefetchingSource source(
+        std::move(opened), 1,
+        [builder = oefmt::SpectraBuilder(context)](const cv::Mat& image) mutable {
+          return builder.build(image);
+        });
 
     trajectory.open(options.output);
     if (!trajectory) throw oefmt::InputError("cannot write '" + options.output + "'");
@@ -179,17 +188,17 @@ int main(int argc, char** argv) {
       if (!estimator) {
         if (intrinsics.valid()) {
           config.fx = intrinsics.fx * config.registration.size /
-                      std::min(frame.image.cols, frame.image.rows);
+                      std::min(frame.image_size.width, frame.image_size.height);
         } else if (!options.quiet) {
           std::fprintf(stderr, "oefmt_offline: no intrinsics (no cam_param.yaml/CameraInfo, no "
                                "--fx): assuming a 53 degree field of view\n");
         }
-        estimator = std::make_unique<oefmt::Estimator>(config);
+        estimator = std::make_unique<oefmt::Estimator>(config, context);
         first_stamp = frame.stamp;
       }
       std::optional<oefmt::Estimate> estimate;
       try {
-        estimate = estimator->push(frame.image, frame.stamp);
+        estimate = estimator->push(std::move(frame.spectra), frame.stamp);
       } catch (const oefmt::InputError& e) {
         throw oefmt::InputError(frame.name + ": " + e.what());  // which frame, for the user
       }

@@ -262,6 +262,42 @@ TEST(Estimator, ResetStampsAndBadInput) {
   EXPECT_LT(second->pose.x, -1.0);  // frame 1 is west of frame 2
 }
 
+// oefmt_offline analyses frames on its reader thread with a SpectraBuilder sharing the
+// estimator's context: the poses must be those of pushing the images themselves.
+TEST(Estimator, FramesAnalysedAheadGiveTheSamePoses) {
+  const test::Flight flight =
+      test::renderFlight(test::flightTexture(), test::straightLine(6, 5.0, -2.0, 0.01, 1.01), kN);
+  const EstimatorConfig config = flightConfig();
+  const std::vector<Estimate> direct = run(flight, config);
+  const auto context = std::make_shared<const SpectralContext>(config.registration);
+  Estimator estimator(config, context);
+  EXPECT_EQ(estimator.spectralContext(), context);
+  SpectraBuilder builder(context);
+  ASSERT_EQ(direct.size(), flight.frames.size());
+  for (std::size_t k = 0; k < flight.frames.size(); ++k) {
+    const std::optional<Estimate> e = estimator.push(builder.build(flight.frames[k]), static_cast<double>(k));
+    ASSERT_TRUE(e.has_value()) << k;
+    EXPECT_EQ(e->state, direct[k].state) << k;
+    EXPECT_DOUBLE_EQ(e->pose.x, direct[k].pose.x) << k;
+    EXPECT_DOUBLE_EQ(e->pose.y, direct[k].pose.y) << k;
+    EXPECT_DOUBLE_EQ(e->pose.z, direct[k].pose.z) << k;
+    EXPECT_DOUBLE_EQ(e->pose.yaw, direct[k].pose.yaw) << k;
+  }
+  EXPECT_GT(std::fabs(estimator.pose().x), 10.0);
+  // Out-of-order stamps are ignored as for images; empty or other-size spectra are refused.
+  EXPECT_FALSE(estimator.push(builder.build(flight.frames[0]), 1.0).has_value());
+  EXPECT_THROW(estimator.push(FrameSpectra{}, 10.0), InputError);
+  RegistrationConfig half = config.registration;
+  half.size = kN / 2;
+  SpectraBuilder other_size(std::make_shared<const SpectralContext>(half));
+  EXPECT_THROW(estimator.push(other_size.build(flight.frames[0]), 10.0), InputError);
+  // A context made for other registration parameters is refused.
+  RegistrationConfig other = config.registration;
+  other.taper_fraction = 0.2;
+  EXPECT_THROW(Estimator(config, std::make_shared<const SpectralContext>(other)), InputError);
+  EXPECT_THROW(Estimator(config, nullptr), InputError);
+}
+
 TEST(Estimator, InvalidConfigurationIsRejected) {
   EstimatorConfig config = flightConfig();
   config.altitude = -1.0;
