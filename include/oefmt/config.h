@@ -20,6 +20,10 @@ struct RegistrationConfig {
   /// Rotation/zoom peaks tried, highest first, while the registration stays below
   /// min_confidence (1 = only the highest).
   int rotation_zoom_candidates = 5;
+  /// A rotation/zoom that moves no pixel (the image corners) by more than this is taken as the
+  /// identity: the older frame's cached spectrum is correlated without a warp and its FFT
+  /// (0 = always warp) [px].
+  double identity_warp_px = 0.1;
   FftPlanning fft_planning = FftPlanning::kMeasure;  ///< FFTW planning effort (once per size)
 
   /// Throws InputError naming the first invalid field.

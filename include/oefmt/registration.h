@@ -45,6 +45,9 @@ struct PairRegistration {
   double confidence = 0.0;          ///< 0 (unusable) .. 1, from both peak-to-sidelobe ratios
   int rotation_zoom_candidate = 0;  ///< which rotation/zoom peak registered (0 = the highest)
   bool half_turn = false;           ///< the 180-degree alternative won
+  /// The older frame was warped before the translation correlation (false: the rotation/zoom
+  /// moved no pixel by more than identity_warp_px and its cached spectrum served).
+  bool warped = true;
 
   bool usable() const { return status == RegistrationStatus::kOk; }
 };

@@ -31,6 +31,8 @@ void RegistrationConfig::validate() const {
           "min_confidence", "must be in [0, 1]");
   require(rotation_zoom_candidates >= 1 && rotation_zoom_candidates <= 10, "rotation_zoom_candidates",
           "must be in [1, 10]");
+  require(std::isfinite(identity_warp_px) && identity_warp_px >= 0.0 && identity_warp_px <= 1.0,
+          "identity_warp_px", "must be in [0, 1] px");
 }
 
 bool operator==(const RegistrationConfig& a, const RegistrationConfig& b) {
@@ -41,6 +43,7 @@ bool operator==(const RegistrationConfig& a, const RegistrationConfig& b) {
          a.resolve_half_turn == b.resolve_half_turn && a.min_texture == b.min_texture &&
          a.min_confidence == b.min_confidence &&
          a.rotation_zoom_candidates == b.rotation_zoom_candidates &&
+         a.identity_warp_px == b.identity_warp_px &&
          a.fft_planning == b.fft_planning;
 }
 

@@ -134,6 +134,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   boolean("resolve_half_turn", r.resolve_half_turn),
                   number("min_texture", r.min_texture), number("min_confidence", r.min_confidence),
                   integer("rotation_zoom_candidates", r.rotation_zoom_candidates),
+                  number("identity_warp_px", r.identity_warp_px),
                   {"fft_planning",
                    [&r](const YamlNode& n, const std::string& k) {
                      const std::string v = readString(n, k);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -214,26 +215,34 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                                       RegistrationMethod method, PairRegistration& result) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
+  // Unless that moves no pixel noticeably: then the older frame's own spectrum (the same
+  // apodized, mean-free image) serves, and the warp and its FFT are saved.
   const Fft2d& fft = context_->fft();
-  cv::Mat1f warped = fft.inPlaceInput(warped_spectrum_);
-  warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
-                         older.mean);
-  fft.forwardInPlace(warped_spectrum_);
+  const double corner = std::sqrt(0.5) * n;
+  const double moved = corner * std::abs(std::polar(result.zoom, result.rotation) - 1.0);
+  result.warped = !(moved <= context_->config().identity_warp_px);
+  if (result.warped) {
+    cv::Mat1f warped = fft.inPlaceInput(warped_spectrum_);
+    warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
+                           older.mean);
+    fft.forwardInPlace(warped_spectrum_);
+  }
+  const cv::Mat2f& older_spectrum = result.warped ? warped_spectrum_ : older.spectrum;
 
   if (context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
     // hypothesis needs no second warp; a low-resolution correlation decides between the two
     // and only the winner gets the full-size inverse FFT.
-    const double same = lowResolutionPeak(newer.spectrum, warped_spectrum_, false,
+    const double same = lowResolutionPeak(newer.spectrum, older_spectrum, false,
                                           context_->smallFft(), small_spectrum_, small_surface_);
-    const double turned = lowResolutionPeak(newer.spectrum, warped_spectrum_, true,
+    const double turned = lowResolutionPeak(newer.spectrum, older_spectrum, true,
                                             context_->smallFft(), small_spectrum_, small_surface_);
     if (turned > same) {
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
   }
-  centredCrossPower(newer.spectrum, warped_spectrum_, cross_power_, result.half_turn);
+  centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn);
   fft.inverseInPlace(cross_power_);
   surface_ = fft.realView(cross_power_);
   SurfaceStats stats;

@@ -24,11 +24,13 @@ namespace {
 
 constexpr int kN = 512;
 
-// Inputs shared by every benchmark: two 8-bit BGR camera frames related by a known motion.
+// Inputs shared by every benchmark: two 8-bit BGR camera frames related by a known motion (a
+// rotation and zoom: the warp runs), and a frame shifted only (level flight at a steady
+// heading: registration.identity_warp_px skips the warp).
 struct Inputs {
   std::shared_ptr<const oefmt::SpectralContext> context;
   cv::Mat older_raw, newer_raw;
-  oefmt::PreparedImage older, newer;
+  oefmt::PreparedImage older, newer, shifted;
 
   Inputs() {
     oefmt::RegistrationConfig config;
@@ -43,6 +45,9 @@ struct Inputs {
     newer_raw = toBgr(oefmt::sim::renderView(texture, {1024, 1024}, motion, kN));
     older = oefmt::prepareImage(older_raw, kN);
     newer = oefmt::prepareImage(newer_raw, kN);
+    oefmt::sim::ViewMotion shift_only;
+    shift_only.shift = {14.0, -9.0};
+    shifted = oefmt::prepareImage(toBgr(oefmt::sim::renderView(texture, {1024, 1024}, shift_only, kN)), kN);
   }
 
   static cv::Mat toBgr(const cv::Mat1f& grey) {
@@ -124,6 +129,16 @@ void BM_RegisterCachedSpectra(benchmark::State& state) {
   timeInFftPairs(state, [&] { benchmark::DoNotOptimize(registrar.registerPair(a, b)); });
 }
 BENCHMARK(BM_RegisterCachedSpectra)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// The same for a shift only: no warp and no forward FFT (the counter `warped` says which ran).
+void BM_RegisterCachedSpectraShiftOnly(benchmark::State& state) {
+  oefmt::Registrar registrar(inputs().context);
+  const oefmt::FrameSpectra a = registrar.analyse(inputs().older);
+  const oefmt::FrameSpectra b = registrar.analyse(inputs().shifted);
+  state.counters["warped"] = registrar.registerPair(a, b).warped ? 1.0 : 0.0;
+  timeInFftPairs(state, [&] { benchmark::DoNotOptimize(registrar.registerPair(a, b)); });
+}
+BENCHMARK(BM_RegisterCachedSpectraShiftOnly)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 void BM_RegisterCachedSpectraClassic(benchmark::State& state) {
   oefmt::Registrar registrar(inputs().context);
