@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "oefmt/error.h"
 #include "oefmt/fft.h"
@@ -214,6 +215,30 @@ TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheCentre) {
   warpSimilarityWindowed(image, CV_PI, 1.0, flat, turned);
   EXPECT_NEAR(turned(64 - 10, 64 - 20), 1.0f, 1e-4);  // x -> N - x about (N/2, N/2)
   EXPECT_NEAR(cv::sum(turned)[0], 1.0, 1e-4);
+}
+
+}  // namespace
+}  // namespace oefmt
+
+namespace oefmt {
+namespace {
+
+// oefmt_offline analyses frames on several threads, each with its own builder: a frame's
+// spectra must not depend on what its builder analysed before.
+TEST(Spectra, AFramesSpectraDoNotDependOnTheBuildersHistory) {
+  const auto first = test::warpedPair(sim::ViewMotion{}, 128, 5);
+  const auto second = test::warpedPair(sim::ViewMotion{}, 128, 9);
+  const auto context = test::sharedContext(128);
+  SpectraBuilder fresh(context), used(context);
+  used.build(first.older);
+  const FrameSpectra a = fresh.build(second.older), b = used.build(second.older);
+  const auto same = [](const cv::Mat& x, const cv::Mat& y) {
+    return x.size() == y.size() && x.type() == y.type() &&
+           std::memcmp(x.data, y.data, x.total() * x.elemSize()) == 0;
+  };
+  EXPECT_TRUE(same(a.grey, b.grey));
+  EXPECT_TRUE(same(a.spectrum, b.spectrum));
+  EXPECT_TRUE(same(a.log_polar_spectrum, b.log_polar_spectrum));
 }
 
 }  // namespace
