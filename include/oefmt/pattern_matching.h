@@ -61,6 +61,17 @@ MatchResult matchShift(const std::vector<float>& a, const std::vector<float>& b,
 std::optional<double> peakNear(const std::vector<float>& v, double bin, double tolerance,
                                double min_fraction);
 
+/// A local maximum of an energy vector: sub-bin position and height.
+struct EnergyPeak {
+  double bin = 0.0;
+  float height = 0.0f;
+};
+
+/// The local maxima of v (ends excluded) at least min_fraction of its maximum high, highest
+/// first, at sub-bin positions (parabolic refinement): the depth layers of a translation energy
+/// vector.
+std::vector<EnergyPeak> energyPeaks(const std::vector<float>& v, double min_fraction);
+
 /// Sub-bin position of the global maximum of v (parabolic refinement; ends are not wrapped).
 double refinedArgmax(const std::vector<float>& v);
 

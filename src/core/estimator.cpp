@@ -253,7 +253,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) 
   est.translation_use12 = obs12.translation_use;
   est.measured12 = initial12;
   if (!usable02) {  // no loop: the gated measurement
-    return detail::steadyLayerStep(initial12, reg12, ref, config, shift_per_bin,
+    return detail::steadyLayerStep(initial12, reg12, translation01, ref, config, shift_per_bin,
                                    double(gap12) / gap01);
   }
 
@@ -270,7 +270,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) 
     return initial12;
   }
   if (ref.shift > 0.0) est.lambda_t02 = est.loop.pair02.shift() / ref.shift;
-  return detail::steadyLayerStep(est.loop.pair12, reg12, ref, config, shift_per_bin,
+  return detail::steadyLayerStep(est.loop.pair12, reg12, translation01, ref, config, shift_per_bin,
                                  double(gap12) / gap01);
 }
 

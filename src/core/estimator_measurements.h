@@ -54,17 +54,23 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 
 /// The step of pair 1-2 that keeps following one depth layer. `candidate` is the loop's step
 /// (without a loop, the gated measurement). When its length is off steady speed (pair 0-1's
-/// shift continued over `intervals`) by more than tracking.layer_gate and pair 1-2's translation
-/// energy vector has a peak of at least tracking.steady_layer_min_fraction of its maximum within
-/// tracking.layer_search of the steady length, that peak gives the length. A hop to another
-/// layer's peak (the dominant peak's, or a stretch matched to the wrong layer, in one pair or in
-/// both pairs of the loop alike) is far likelier than a speed change by a layer ratio within one
-/// frame interval; a real speed change leaves no peak at the steady length and stands. Slow
-/// motion (a steady length within 4 x matching.skip_bins, where a static pattern's no-motion
-/// peak lies) is left alone too.
+/// shift continued over `intervals`) by more than tracking.layer_gate:
+/// - a peak of pair 1-2's translation energy vector within layer_gate of the steady length (the
+///   followed layer) gives the length;
+/// - without one (the layer has left the view), the layers seen in both pairs at steady speed
+///   (a peak of pair 1-2 and one of pair 0-1's `translation01` within layer_gate of each other
+///   over the intervals) give the speed ratio, the one nearest to steady wins, and the step is
+///   the steady length times it: the followed layer's scale is kept.
+/// Pair 1-2's peaks must reach tracking.steady_layer_min_fraction of its maximum, pair 0-1's
+/// tracking.layer_min_fraction. A hop to another layer's peak (the dominant peak's, or a stretch
+/// matched to the wrong layer, in one pair or in both pairs of the loop alike) is far likelier
+/// than a speed change by a layer ratio within one frame interval; a real speed change leaves no
+/// layer at steady speed and stands (one by exactly the ratio of two layers' depths cannot be
+/// told from a hop). Slow motion (a steady length within 4 x matching.skip_bins, where a static
+/// pattern's no-motion peak lies) is left alone too.
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
-                           const Reference& reference, const EstimatorConfig& config,
-                           double shift_per_bin, double intervals);
+                           const std::vector<float>& translation01, const Reference& reference,
+                           const EstimatorConfig& config, double shift_per_bin, double intervals);
 
 }  // namespace detail
 }  // namespace oefmt

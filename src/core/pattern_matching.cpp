@@ -339,6 +339,21 @@ std::optional<double> peakNear(const std::vector<float>& v, double bin, double t
   return best;
 }
 
+std::vector<EnergyPeak> energyPeaks(const std::vector<float>& v, double min_fraction) {
+  std::vector<EnergyPeak> peaks;
+  const int n = static_cast<int>(v.size());
+  if (n < 3) return peaks;
+  const float top = *std::max_element(v.begin(), v.end());
+  if (!(top > 0.0f)) return peaks;
+  for (int j = 1; j < n - 1; ++j) {
+    if (!(v[j] >= v[j - 1] && v[j] > v[j + 1]) || v[j] < min_fraction * top) continue;
+    peaks.push_back({j + parabolaVertex(-v[j - 1], -v[j], -v[j + 1]).offset, v[j]});
+  }
+  std::sort(peaks.begin(), peaks.end(),
+            [](const EnergyPeak& a, const EnergyPeak& b) { return a.height > b.height; });
+  return peaks;
+}
+
 double refinedArgmax(const std::vector<float>& v) {
   const int n = static_cast<int>(v.size());
   if (n == 0) return 0.0;

@@ -27,16 +27,28 @@ detail::Reference referenceOf(double shift) {
   return ref;
 }
 
-// Pair 1-2 of a scene whose layers' peaks lie at the given bins with the given heights.
-PairRegistration withPeaks(const std::vector<std::pair<double, double>>& peaks) {
-  PairRegistration r;
-  r.translation_energy.assign(256, 0.0f);
+// A translation energy vector whose layers' peaks lie at the given bins with the given heights.
+std::vector<float> energyWithPeaks(const std::vector<std::pair<double, double>>& peaks) {
+  std::vector<float> v(256, 0.0f);
   for (int j = 0; j < 256; ++j) {
     for (const auto& [bin, height] : peaks) {
-      r.translation_energy[j] += static_cast<float>(height * std::exp(-0.5 * (j - bin) * (j - bin) / 4.0));
+      v[j] += static_cast<float>(height * std::exp(-0.5 * (j - bin) * (j - bin) / 4.0));
     }
   }
+  return v;
+}
+
+// Pair 1-2 of such a scene.
+PairRegistration withPeaks(const std::vector<std::pair<double, double>>& peaks) {
+  PairRegistration r;
+  r.translation_energy = energyWithPeaks(peaks);
   return r;
+}
+
+// Pair 0-1 of the two-layer scene of most cases below: ground 92.7 px, roofs x1.43.
+const std::vector<float>& groundAndRoofs01() {
+  static const std::vector<float> v = energyWithPeaks({{92.7, 1.0}, {132.5, 0.5}});
+  return v;
 }
 
 // Pair 0-1 moved 92.7 px along the ground. The roofs (x1.43) took over pair 1-2's dominant
@@ -45,7 +57,7 @@ PairRegistration withPeaks(const std::vector<std::pair<double, double>>& peaks) 
 TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
   PairMotion loop = motionAlongX(132.5);
   loop.translation = {132.5 * std::cos(0.3), 132.5 * std::sin(0.3)};
-  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{92.7, 0.08}, {132.5, 1.0}}),
+  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{92.7, 0.08}, {132.5, 1.0}}), groundAndRoofs01(),
                                                   referenceOf(92.7), EstimatorConfig(), kShiftPerBin, 1.0);
   EXPECT_NEAR(step.shift(), 92.7, 0.1);
   EXPECT_NEAR(step.direction(), 0.3, 1e-9);
@@ -56,7 +68,7 @@ TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
 // A real speed change (x1.6, one layer) leaves no peak at the steady length: it stands.
 TEST(SteadyLayerStep, ASpeedChangeStands) {
   const PairMotion loop = motionAlongX(148.3);
-  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{148.3, 1.0}}), referenceOf(92.7),
+  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{148.3, 1.0}}), groundAndRoofs01(), referenceOf(92.7),
                                                   EstimatorConfig(), kShiftPerBin, 1.0);
   EXPECT_DOUBLE_EQ(step.shift(), 148.3);
 }
@@ -64,29 +76,56 @@ TEST(SteadyLayerStep, ASpeedChangeStands) {
 // Pair 0-2 spans two of pair 0-1's intervals: steady speed means twice its shift.
 TEST(SteadyLayerStep, SteadySpeedScalesWithTheFrameIntervals) {
   const PairMotion loop = motionAlongX(265.0);
-  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{185.4, 0.2}, {265.0, 1.0}}),
+  const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{185.4, 0.2}, {265.0, 1.0}}), groundAndRoofs01(),
                                                   referenceOf(92.7), EstimatorConfig(), kShiftPerBin, 2.0);
   EXPECT_NEAR(step.shift(), 185.4, 0.1);
 }
 
-// A step at steady speed, a peak too small to be a layer, or no reference: the step stands.
+// A step at steady speed, a peak too small to be a layer (and no layer that pair 0-1 saw at
+// steady speed), or no reference: the step stands.
 TEST(SteadyLayerStep, StepsAtSteadySpeedOrWithoutEvidenceStand) {
   EstimatorConfig config;
-  EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(94.0), withPeaks({{92.7, 1.0}}), referenceOf(92.7),
-                                           config, kShiftPerBin, 1.0).shift(), 94.0);
+  const std::vector<float> ground01 = energyWithPeaks({{92.7, 1.0}});
+  EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(94.0), withPeaks({{92.7, 1.0}}), ground01,
+                                           referenceOf(92.7), config, kShiftPerBin, 1.0).shift(), 94.0);
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.01}, {132.5, 1.0}}),
-                                           referenceOf(92.7), config, kShiftPerBin, 1.0).shift(), 132.5);
+                                           ground01, referenceOf(92.7), config, kShiftPerBin, 1.0).shift(),
+                   132.5);
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.5}, {132.5, 1.0}}),
-                                           referenceOf(0.0), config, kShiftPerBin, 1.0).shift(), 132.5);
+                                           groundAndRoofs01(), referenceOf(0.0), config, kShiftPerBin, 1.0)
+                       .shift(),
+                   132.5);
   config.tracking.steady_layer_min_fraction = 1.0;  // only the largest peak would do
   EXPECT_DOUBLE_EQ(detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 0.5}, {132.5, 1.0}}),
-                                           referenceOf(92.7), config, kShiftPerBin, 1.0).shift(), 132.5);
+                                           ground01, referenceOf(92.7), config, kShiftPerBin, 1.0).shift(),
+                   132.5);
+}
+
+// The followed layer (roofs, 132.5 px in pair 0-1) has left the view; the loop took the middle
+// layer's peak (119.5 px). The layers that pair 0-1 also saw keep their speed: the step keeps the
+// roofs' scale, and follows a small speed change of those layers.
+TEST(SteadyLayerStep, TheFollowedLayerLeavingKeepsItsScale) {
+  const std::vector<float> three01 = energyWithPeaks({{92.7, 1.0}, {119.5, 0.6}, {132.5, 0.3}});
+  const PairMotion steady = detail::steadyLayerStep(
+      motionAlongX(119.5), withPeaks({{92.7, 1.0}, {119.5, 0.7}}), three01, referenceOf(132.5),
+      EstimatorConfig(), kShiftPerBin, 1.0);
+  EXPECT_NEAR(steady.shift(), 132.5, 0.2);
+  const PairMotion faster = detail::steadyLayerStep(
+      motionAlongX(121.9), withPeaks({{94.55, 1.0}, {121.9, 0.7}}), three01, referenceOf(132.5),
+      EstimatorConfig(), kShiftPerBin, 1.0);
+  EXPECT_NEAR(faster.shift(), 132.5 * 1.02, 0.3);
+  // A speed change beyond layer_gate for every layer: nothing was seen at steady speed, it stands.
+  // (A change by a ratio between two layers' depths, x1.29 here, cannot be told from a hop.)
+  const PairMotion changed = detail::steadyLayerStep(
+      motionAlongX(119.5 * 1.6), withPeaks({{92.7 * 1.6, 1.0}, {119.5 * 1.6, 0.7}}), three01,
+      referenceOf(132.5), EstimatorConfig(), kShiftPerBin, 1.0);
+  EXPECT_NEAR(changed.shift(), 119.5 * 1.6, 1e-9);
 }
 
 // Slow motion: a steady length inside the no-motion zone (4 x skip_bins = 20 bins here), where a
 // static pattern peaks, does not hold back a speed-up.
 TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
-  const PairMotion step = detail::steadyLayerStep(motionAlongX(12.0), withPeaks({{6.0, 0.5}, {12.0, 1.0}}),
+  const PairMotion step = detail::steadyLayerStep(motionAlongX(12.0), withPeaks({{6.0, 0.5}, {12.0, 1.0}}), groundAndRoofs01(),
                                                   referenceOf(6.0), EstimatorConfig(), kShiftPerBin, 1.0);
   EXPECT_DOUBLE_EQ(step.shift(), 12.0);
 }
