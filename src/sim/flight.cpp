@@ -73,7 +73,9 @@ FlightPlan planFlight(const FlightOptions& o) {
   SceneConfig& scene = plan.scene;
   scene.seed = o.seed;
   std::vector<double> heights = o.level_heights;
-  if (heights.empty()) heights = {0.15 * altitude, 0.30 * altitude};
+  // Three levels as the authors' scene has three depths of blocks, the inclined one between the
+  // flat ones; together with the ground they compete for the dominant correlation peak.
+  if (heights.empty()) heights = {0.15 * altitude, 0.30 * altitude, 0.225 * altitude};
   if (o.flat) heights.clear();
   scene.levels.clear();
   for (std::size_t l = 0; l < heights.size(); ++l) {

@@ -50,11 +50,12 @@ camera:
   --k1 K, --k2 K             radial distortion rendered and written to cam_param/CameraInfo
 scene:
   --seed N                   scene and noise seed (default 1)
-  --levels H1,H2,...         raised levels' heights [m] (default 0.15 and 0.30 of the altitude)
+  --levels H1,H2,...         raised levels' heights [m] (default 0.15, 0.30 and 0.225 of the
+                             altitude)
   --flat                     ground plane only, no raised levels
   --incline DEG              tilt of the last level's terraces (default 6)
-  --raised F                 fraction of the terraces raised, split among the levels (0.7)
-  --fill F                   probability that a cell of a raised terrace has a top (0.6)
+  --raised F                 fraction of the terraces raised, split among the levels (1)
+  --fill F                   probability that a cell of a raised terrace has a top (0.8)
   --cell M                   block pitch [m] (default 0.22 of the ground footprint's width at
                              the mean altitude)
   --texel M                  texture resolution [m] (default half a ground pixel at the mean

@@ -52,5 +52,12 @@ int argmax(const std::vector<float>& v) {
   return static_cast<int>(std::max_element(v.begin(), v.end()) - v.begin());
 }
 
+std::vector<double> levelHeights(const sim::FlightOptions& options, const std::vector<double>& fractions) {
+  const double altitude = sim::planFlight(options).track.altitude;
+  std::vector<double> heights;
+  for (double fraction : fractions) heights.push_back(fraction * altitude);
+  return heights;
+}
+
 }  // namespace test
 }  // namespace oefmt

@@ -3,10 +3,12 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "oefmt/registration.h"
+#include "oefmt/sim/flight.h"
 #include "oefmt/sim/similarity_views.h"
 
 namespace oefmt {
@@ -34,6 +36,10 @@ int argmax(const std::vector<float>& v);
 
 inline double deg(double radians) { return radians * 180.0 / CV_PI; }
 inline double rad(double degrees) { return degrees * CV_PI / 180.0; }
+
+/// Raised levels at the given fractions of the flight's altitude (as oefmt_simulate's default
+/// levels are), for a scene other than the default's.
+std::vector<double> levelHeights(const sim::FlightOptions& options, const std::vector<double>& fractions);
 
 }  // namespace test
 }  // namespace oefmt

@@ -9,6 +9,7 @@
 #include "oefmt/estimator.h"
 #include "oefmt/evaluation.h"
 #include "oefmt/sim/flight.h"
+#include "support/fixtures.h"
 
 namespace oefmt {
 namespace {
@@ -24,6 +25,7 @@ sim::FlightOptions balancedFlight() {
   options.raised_share = 1.0;
   options.fill = 0.9;
   options.incline_deg = 0.0;
+  options.level_heights = test::levelHeights(options, {0.15, 0.30});
   return options;
 }
 

@@ -9,13 +9,15 @@
 #include "oefmt/registration.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
+#include "support/fixtures.h"
 
 namespace oefmt {
 namespace {
 
-// Frames 71 and 72 (1-based, as oefmt_simulate names them) of
-// `oefmt_simulate --raised 1 --fill 0.8`: a level flight with fixed heading, so the truth is no
-// rotation, no zoom, and the ground's shift of about 92.6 px.
+// Frames 71 and 72 (1-based, as oefmt_simulate names them) of `oefmt_simulate --raised 1
+// --fill 0.8` with two raised levels at 0.15 and 0.30 of the altitude (the default levels until
+// the third was added): a level flight with fixed heading, so the truth is no rotation, no
+// zoom, and the ground's shift of about 92.6 px.
 struct LatticePair {
   cv::Mat1b older, newer;
   double ground_shift = 0.0;  // [px]
@@ -25,6 +27,7 @@ LatticePair latticePair() {
   sim::FlightOptions options;
   options.raised_share = 1.0;
   options.fill = 0.8;
+  options.level_heights = test::levelHeights(options, {0.15, 0.30});
   const sim::FlightPlan plan = sim::planFlight(options);
   const sim::Renderer renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, plan.supersample);
   LatticePair pair;

@@ -160,9 +160,17 @@ TEST(SimFlightPlan, DefaultCircleOverlapsSeventyToEightyFivePercent) {
   EXPECT_GE(plan.ground_overlap.min, 0.70);
   EXPECT_LE(plan.ground_overlap.max, 0.85);
   EXPECT_NEAR(plan.ground_overlap.mean, 0.78, 0.005);
-  ASSERT_EQ(plan.scene.levels.size(), 2u);
+  // Three raised levels at 0.15, 0.30 and 0.225 of the altitude, the last inclined 6 degrees,
+  // every terrace raised.
+  ASSERT_EQ(plan.scene.levels.size(), 3u);
+  EXPECT_NEAR(plan.scene.levels[0].height, 0.15 * plan.track.altitude, 1e-9);
+  EXPECT_NEAR(plan.scene.levels[1].height, 0.30 * plan.track.altitude, 1e-9);
+  EXPECT_NEAR(plan.scene.levels[2].height, 0.225 * plan.track.altitude, 1e-9);
   EXPECT_EQ(plan.scene.levels[0].incline_deg, 0.0);
-  EXPECT_EQ(plan.scene.levels[1].incline_deg, 6.0);
+  EXPECT_EQ(plan.scene.levels[1].incline_deg, 0.0);
+  EXPECT_EQ(plan.scene.levels[2].incline_deg, 6.0);
+  EXPECT_NEAR(plan.scene.levels[0].share + plan.scene.levels[1].share + plan.scene.levels[2].share, 1.0, 1e-9);
+  EXPECT_DOUBLE_EQ(plan.scene.fill, 0.8);
   EXPECT_LT(plan.scene.highestTop(), plan.track.altitude);
   ASSERT_EQ(plan.stamps.size(), 200u);
   EXPECT_DOUBLE_EQ(plan.stamps[0], 1.0);

@@ -38,12 +38,12 @@ struct FlightOptions {
   double cy = -1.0;           ///< [px]; < 0: (height - 1) / 2
   Distortion distortion;      ///< k1, k2 (p1, p2) of the rendered lens
   std::uint32_t seed = 1;
-  /// Raised levels' heights [m]; empty: 0.15 and 0.30 of the altitude.
+  /// Raised levels' heights [m]; empty: 0.15, 0.30 and 0.225 of the altitude (the last inclined).
   std::vector<double> level_heights;
   bool flat = false;          ///< ground plane only (no raised levels)
   double incline_deg = 6.0;   ///< tilt of the last level's terraces [deg]
-  double raised_share = 0.7;  ///< fraction of terraces raised, split evenly among the levels
-  double fill = 0.6;          ///< probability that a cell of a raised terrace has a top
+  double raised_share = 1.0;  ///< fraction of terraces raised, split evenly among the levels
+  double fill = 0.8;          ///< probability that a cell of a raised terrace has a top
   double cell_size = 0.0;     ///< block pitch [m]; 0: 0.22 of the mean ground footprint's width
   double texel = 0.0;         ///< texture resolution [m]; 0: half a ground pixel at mean altitude
   int texture_size = 0;       ///< procedural texture side [texels]; 0: 8 * width, at most 4096
