@@ -153,8 +153,9 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
     for (const EnergyPeak& p : energyPeaks(registration12.translation_energy, min_fraction)) {
       const double expected = p.bin / intervals;  // where pair 0-1 saw this layer
       for (const EnergyPeak& q : peaks01) {
+        if (!(q.bin > 0.0)) continue;
         const double r = expected / q.bin;
-        if (q.bin > 0.0 && std::fabs(r - 1.0) <= tracking.layer_gate &&
+        if (std::fabs(r - 1.0) <= tracking.layer_gate &&
             (!ratio || std::fabs(r - 1.0) < std::fabs(*ratio - 1.0))) {
           ratio = r;
         }

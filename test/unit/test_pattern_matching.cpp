@@ -148,6 +148,19 @@ TEST(PeakNear, FindsTheLayerNearestThePrediction) {
   EXPECT_NEAR(refinedArgmax(v), 26.6, 0.05);
 }
 
+TEST(EnergyPeaks, ListsTheLayersHighestFirst) {
+  const std::vector<EnergyPeak> both = energyPeaks(twoLayers(1.0), 0.05);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_NEAR(both[0].bin, 26.6, 0.05);  // the higher one first
+  EXPECT_NEAR(both[1].bin, 13.3, 0.05);
+  EXPECT_GT(both[0].height, both[1].height);
+  const std::vector<EnergyPeak> high = energyPeaks(twoLayers(1.0), 0.5);  // the 0.4 layer drops
+  ASSERT_EQ(high.size(), 1u);
+  EXPECT_NEAR(high[0].bin, 26.6, 0.05);
+  EXPECT_TRUE(energyPeaks(std::vector<float>(kN, 0.0f), 0.05).empty());
+  EXPECT_TRUE(energyPeaks({1.0f, 0.5f}, 0.05).empty());
+}
+
 // Spec 8.9 on rendered images: two planes moving 10 and 20 px, then 15 and 30 px.
 TEST(StretchMatch, RenderedTwoPlanePairsAtOneAndAHalfTimesTheSpeed) {
   const cv::Mat1f ground = sim::proceduralTexture({2048, 2048}, 11, sim::TextureStyle::kCells, 40);
