@@ -153,6 +153,28 @@ TEST(Tools, OfflineKeepsTheTrajectoryOnBadInput) {
   EXPECT_NE(missing.err.find("nowhere"), std::string::npos) << missing.err;
 }
 
+// Frames smaller than registration.size are upscaled, which registers worse: a warning names the
+// size to set; with that size, none.
+TEST(Tools, OfflineWarnsWhenFramesAreUpscaled) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
+                                    (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  const ToolRun upscaled = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                        " --output " + (dir / "a.tum"));
+  EXPECT_EQ(upscaled.status, 0) << upscaled.err;
+  EXPECT_NE(upscaled.err.find("upscaled to registration.size 512"), std::string::npos) << upscaled.err;
+  EXPECT_NE(upscaled.err.find("at most 128"), std::string::npos) << upscaled.err;
+  {
+    std::ofstream config(dir / "size128.yaml");
+    config << "%YAML:1.0\nregistration:\n  size: 128\n";
+  }
+  const ToolRun native = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --config " + (dir / "size128.yaml") +
+                                      " --images " + (dir / "flight") + " --output " + (dir / "b.tum"));
+  EXPECT_EQ(native.status, 0) << native.err;
+  EXPECT_EQ(native.err.find("upscaled"), std::string::npos) << native.err;
+}
+
 // A folder of tiny (40 x 30) frames: a clear message with the size, exit status 1.
 TEST(Tools, OfflineRefusesTinyFrames) {
   TempDir dir;
