@@ -128,6 +128,8 @@ class Estimator {
 
  private:
   struct State;
+  // Finite and not earlier than the previous frame's (a frame that is not changes nothing).
+  bool acceptsStamp(double stamp) const;
   std::optional<Estimate> process(FrameSpectra spectra, double stamp, double prepare_ms);
 
   EstimatorConfig config_;

@@ -327,15 +327,19 @@ const Pose4& Estimator::pose() const { return state_->integrator.pose(); }
 double Estimator::shiftPerBin() const { return state_->registrar.shiftPerBin(); }
 double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
 
+bool Estimator::acceptsStamp(double stamp) const {
+  return std::isfinite(stamp) && stamp >= state_->last_stamp;
+}
+
 std::optional<Estimate> Estimator::push(const cv::Mat& image, double stamp, ChannelOrder order) {
-  if (!std::isfinite(stamp) || stamp < state_->last_stamp) return std::nullopt;
+  if (!acceptsStamp(stamp)) return std::nullopt;
   const Clock::time_point start = Clock::now();
   FrameSpectra spectra = state_->registrar.analyse(image, order);
   return process(std::move(spectra), stamp, msSince(start));
 }
 
 std::optional<Estimate> Estimator::push(const PreparedImage& image, double stamp) {
-  if (!std::isfinite(stamp) || stamp < state_->last_stamp) return std::nullopt;
+  if (!acceptsStamp(stamp)) return std::nullopt;
   const Clock::time_point start = Clock::now();
   FrameSpectra spectra = state_->registrar.analyse(image);
   return process(std::move(spectra), stamp, msSince(start));
@@ -347,7 +351,7 @@ std::optional<Estimate> Estimator::push(FrameSpectra spectra, double stamp) {
       spectra.spectrum.rows != n || spectra.log_polar_spectrum.rows != n) {
     throw InputError("Estimator: the frame's spectra are empty or not of size " + std::to_string(n));
   }
-  if (!std::isfinite(stamp) || stamp < state_->last_stamp) return std::nullopt;
+  if (!acceptsStamp(stamp)) return std::nullopt;
   return process(std::move(spectra), stamp, 0.0);
 }
 

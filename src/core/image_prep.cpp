@@ -83,6 +83,15 @@ void requireRegistrableSize(const cv::Mat& image) {
   }
 }
 
+std::string upscalingWarning(cv::Size image_size, int size) {
+  const int side = std::min(image_size.width, image_size.height);
+  if (side >= size) return std::string();
+  return "the images (" + std::to_string(image_size.width) + "x" + std::to_string(image_size.height) +
+         ") are upscaled to registration.size " + std::to_string(size) +
+         ", which registers worse than working at their own size: set registration.size to at most " +
+         std::to_string(side / 2 * 2);
+}
+
 PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
   if (size < 64 || size % 2 != 0) {
     throw InputError("working size must be even and >= 64, got " + std::to_string(size));

@@ -174,6 +174,13 @@ bool usable(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() >= 8 && a.size() == b.size();
 }
 
+// Sub-bin position (parabolic refinement) of v[j], 0 < j < size - 1, when it is a local maximum
+// (a plateau counts at its left end) at least `floor` high.
+std::optional<double> localMaximumAt(const std::vector<float>& v, int j, double floor) {
+  if (!(v[j] >= v[j - 1] && v[j] > v[j + 1]) || v[j] < floor) return std::nullopt;
+  return j + parabolaVertex(-v[j - 1], -v[j], -v[j + 1]).offset;
+}
+
 }  // namespace
 
 MatchResult matchStretch(const std::vector<float>& a_in, const std::vector<float>& b_in,
@@ -330,11 +337,9 @@ std::optional<double> peakNear(const std::vector<float>& v, double bin, double t
   const int hi = std::min(n - 2, static_cast<int>(std::ceil(bin + tolerance)) + 1);
   std::optional<double> best;
   for (int j = lo; j <= hi; ++j) {
-    if (!(v[j] >= v[j - 1] && v[j] > v[j + 1]) || v[j] < min_fraction * top) continue;
-    const Vertex vertex = parabolaVertex(-v[j - 1], -v[j], -v[j + 1]);
-    const double position = j + vertex.offset;
-    if (std::fabs(position - bin) > tolerance) continue;
-    if (!best || std::fabs(position - bin) < std::fabs(*best - bin)) best = position;
+    const std::optional<double> position = localMaximumAt(v, j, min_fraction * top);
+    if (!position || std::fabs(*position - bin) > tolerance) continue;
+    if (!best || std::fabs(*position - bin) < std::fabs(*best - bin)) best = position;
   }
   return best;
 }
@@ -346,8 +351,9 @@ std::vector<EnergyPeak> energyPeaks(const std::vector<float>& v, double min_frac
   const float top = *std::max_element(v.begin(), v.end());
   if (!(top > 0.0f)) return peaks;
   for (int j = 1; j < n - 1; ++j) {
-    if (!(v[j] >= v[j - 1] && v[j] > v[j + 1]) || v[j] < min_fraction * top) continue;
-    peaks.push_back({j + parabolaVertex(-v[j - 1], -v[j], -v[j + 1]).offset, v[j]});
+    if (const std::optional<double> position = localMaximumAt(v, j, min_fraction * top)) {
+      peaks.push_back({*position, v[j]});
+    }
   }
   std::sort(peaks.begin(), peaks.end(),
             [](const EnergyPeak& a, const EnergyPeak& b) { return a.height > b.height; });

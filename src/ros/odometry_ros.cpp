@@ -310,13 +310,8 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     ROS_INFO_STREAM(name_ << ": odometry started at " << frame.stamp << " (" << image.cols << "x"
                           << image.rows << ", working fx " << working_fx << " px, scale "
                           << (config.altitude > 0.0 ? "metric" : "initial altitude = 1") << ")");
-    if (std::min(image.cols, image.rows) < config.registration.size) {
-      ROS_WARN_STREAM(name_ << ": the images (" << image.cols << "x" << image.rows
-                            << ") are upscaled to registration.size " << config.registration.size
-                            << ", which registers worse than working at their own size: set "
-                               "registration.size to at most "
-                            << std::min(image.cols, image.rows) / 2 * 2);
-    }
+    const std::string upscaling = upscalingWarning(image.size(), config.registration.size);
+    if (!upscaling.empty()) ROS_WARN_STREAM(name_ << ": " << upscaling);
   }
   return true;
 }

@@ -195,15 +195,8 @@ int main(int argc, char** argv) {
                                "--fx): assuming a 53 degree field of view\n");
         }
         estimator = std::make_unique<oefmt::Estimator>(config, context);
-        const int side = std::min(frame.image_size.width, frame.image_size.height);
-        if (side < config.registration.size) {
-          // 256 px frames of the default flight upscaled to 512: 1.09 m ATE; at 256: 0.09 m.
-          std::fprintf(stderr, "oefmt_offline: warning: the images (%dx%d) are upscaled to "
-                               "registration.size %d, which registers worse than working at "
-                               "their own size: set registration.size to at most %d\n",
-                       frame.image_size.width, frame.image_size.height, config.registration.size,
-                       side / 2 * 2);
-        }
+        const std::string upscaling = oefmt::upscalingWarning(frame.image_size, config.registration.size);
+        if (!upscaling.empty()) std::fprintf(stderr, "oefmt_offline: warning: %s\n", upscaling.c_str());
         first_stamp = frame.stamp;
       }
       std::optional<oefmt::Estimate> estimate;

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/image_prep.h"
 #include "oefmt/registration.h"
 #include "oefmt/sim/texture.h"
 #include "support/fixtures.h"
@@ -297,6 +298,18 @@ TEST(Registration, TinyFramesAreRefusedWithTheirSize) {
     }
   }
   EXPECT_NO_THROW(registrar.analyse(cv::Mat(64, 100, CV_8UC1, cv::Scalar(7))));
+}
+
+// Frames smaller than the working size are upscaled, which registers worse: the warning the
+// node and oefmt_offline give names the size to set; none for frames at least that large.
+TEST(Registration, UpscaledFramesGetAWarningNamingTheSize) {
+  const std::string warning = upscalingWarning(cv::Size(321, 256), 512);
+  EXPECT_NE(warning.find("(321x256)"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("upscaled to registration.size 512"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("at most 256"), std::string::npos) << warning;
+  EXPECT_NE(upscalingWarning(cv::Size(640, 255), 512).find("at most 254"), std::string::npos);
+  EXPECT_TRUE(upscalingWarning(cv::Size(640, 512), 512).empty());
+  EXPECT_TRUE(upscalingWarning(cv::Size(4056, 3040), 512).empty());
 }
 
 // A full-resolution 4056 x 3040 colour frame (the authors' camera) registers like its
