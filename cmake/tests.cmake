@@ -6,11 +6,12 @@ catkin_add_gtest(oefmt_io_tests test/io/test_bag_io.cpp test/io/test_tools.cpp
                  test/io/test_debug_rendering.cpp test/support/gtest_main.cpp)
 if(TARGET oefmt_io_tests)
   target_include_directories(oefmt_io_tests PRIVATE test)
-  target_link_libraries(oefmt_io_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_core)
+  target_link_libraries(oefmt_io_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_core opencv_imgcodecs)
   target_compile_definitions(oefmt_io_tests PRIVATE
     OEFMT_SIMULATE="$<TARGET_FILE:oefmt_simulate>"
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"
     OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>"
-    OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>")
+    OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>"
+    OEFMT_CORE_LIBRARY="$<TARGET_FILE:oefmt_core>")
   add_dependencies(oefmt_io_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline)
 endif()

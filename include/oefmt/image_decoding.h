@@ -2,7 +2,9 @@
 // Image file decoding for datasets and compressed image messages. PNG is what simulators and
 // bag recorders write, and OpenCV's libpng + zlib path spends ~10 ms on one 512x512 RGB frame
 // here (more than the registration): common PNGs get a fast path (libdeflate inflate, tight
-// unfilter loops, ~4 ms), everything else goes to cv::imdecode.
+// unfilter loops, ~4 ms), everything else goes to cv::imdecode. OpenCV's imgcodecs is not linked:
+// it is loaded on first use (liboefmt_image_codecs.so, beside liboefmt_core.so), as linking it
+// costs every process ~0.13 s of start-up and ~40 MB for libraries the PNG path never needs.
 #pragma once
 
 #include <cstddef>
@@ -26,7 +28,8 @@ std::optional<cv::Mat> decodePngFast(const std::uint8_t* data, std::size_t size)
 
 /// Decodes PNG, JPEG, TIFF, ... as cv::imdecode(IMREAD_UNCHANGED), PNGs through decodePngFast.
 /// Returns an empty Mat when the data is not a readable image; throws InputError for an image
-/// header over kMaxDecodedPixels (the message gives its size).
+/// header over kMaxDecodedPixels (the message gives its size), std::runtime_error when an image
+/// needs imgcodecs and its plugin cannot be loaded.
 cv::Mat decodeImage(const std::uint8_t* data, std::size_t size);
 
 /// Reads a whole file and decodes it with decodeImage. Empty Mat when the file cannot be read

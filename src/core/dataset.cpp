@@ -18,6 +18,16 @@ namespace oefmt {
 namespace fs = std::filesystem;
 namespace {
 
+// readImageFile with the file named in its errors too (an image over the size limit, no
+// imgcodecs plugin for a format the fast path does not read).
+cv::Mat readNamedImage(const std::string& path) {
+  try {
+    return readImageFile(path);
+  } catch (const std::exception& e) {
+    throw DatasetError("cannot read image '" + path + "': " + e.what());
+  }
+}
+
 std::string trim(const std::string& text) {
   const auto first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) return "";
@@ -170,7 +180,7 @@ FolderDataset::FolderDataset(const std::string& directory) : directory_(director
   readImageList();
   if (names_.empty()) throw DatasetError("dataset '" + directory_ + "' lists no image");
 
-  const cv::Mat first = readImageFile(paths_[0]);
+  const cv::Mat first = readNamedImage(paths_[0]);
   if (first.empty()) {
     throw DatasetError(fs::exists(paths_[0]) ? "cannot read image '" + paths_[0] + "' (not an image?)"
                                              : "image '" + paths_[0] + "' does not exist");
@@ -263,7 +273,7 @@ double FolderDataset::timestamp(std::size_t index) const {
 
 cv::Mat FolderDataset::loadImage(std::size_t index) const {
   const std::string& path = imagePath(index);
-  cv::Mat image = readImageFile(path);
+  cv::Mat image = readNamedImage(path);
   if (image.empty()) {
     throw DatasetError(fs::exists(path) ? "cannot read image '" + path + "' (not an image or corrupt)"
                                         : "image '" + path + "' does not exist");

@@ -10,8 +10,7 @@
 #include <memory>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
+#include "image_codec_module.h"
 #include "oefmt/error.h"
 
 namespace oefmt {
@@ -253,14 +252,7 @@ cv::Mat decodeImage(const std::uint8_t* data, std::size_t size) {
                        " pixels: over the limit of " + std::to_string(kMaxDecodedPixels) + " pixels");
     }
   }
-  try {
-    // A view, not a copy: cv::imdecode only reads it.
-    const cv::Mat buffer(1, static_cast<int>(std::min<std::size_t>(size, INT32_MAX)), CV_8U,
-                         const_cast<std::uint8_t*>(data));
-    return cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    return cv::Mat();  // OpenCV throws on some damaged files instead of returning empty
-  }
+  return detail::imageCodecModule().decode(data, size);
 }
 
 cv::Mat readImageFile(const std::string& path) {

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <map>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -15,6 +14,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/image_decoding.h"
+#include "oefmt/image_encoding.h"
 
 namespace oefmt {
 namespace {
@@ -133,7 +133,7 @@ cv::Mat imageFromMessage(const sensor_msgs::CompressedImage& message) {
   if (!message.data.empty()) {
     try {
       image = decodeImage(message.data.data(), message.data.size());
-    } catch (const InputError& e) {
+    } catch (const std::exception& e) {  // an image over the size limit, no imgcodecs plugin
       throw BagError(std::string("compressed image: ") + e.what());
     }
   }
@@ -387,16 +387,14 @@ void BagFlightWriter::write(const cv::Mat& image, double stamp) {
       message.header.stamp = time;
       message.header.frame_id = options_.frame_id;
       message.format = options_.image_format;
-      if (!cv::imencode("." + options_.image_format, image, message.data)) {
-        throw BagError("cannot encode an image of type " + cv::typeToString(image.type()) + " as " + options_.image_format);
-      }
+      message.data = encodeImage(options_.image_format, image);
       state_->bag.write(options_.image_topic, time, message);
     }
     state_->bag.write(options_.camera_info_topic, time, cameraInfoMessage(camera_, stamp, options_.frame_id));
   } catch (const rosbag::BagException& e) {
     throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
-  } catch (const cv::Exception& e) {
-    throw BagError("cannot encode image for bag '" + state_->path + "': " + e.err);
+  } catch (const std::exception& e) {
+    throw BagError("cannot encode image for bag '" + state_->path + "': " + e.what());
   }
   ++written_;
 }

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include <opencv2/imgcodecs.hpp>
+#include "oefmt/image_encoding.h"
 
 namespace oefmt {
 namespace sim {
@@ -33,13 +33,11 @@ void FolderFlightWriter::write(const cv::Mat& image, const FlightPose& pose, dou
   char name[32];
   std::snprintf(name, sizeof(name), "%0*d.png", digits_, static_cast<int>(names_.size()) + 1);
   const std::string path = (fs::path(directory_) / "Images" / name).string();
-  bool written = false;
   try {
-    written = cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw DatasetError("cannot write image '" + path + "': " + e.err);
+    writeImageFile(path, image);
+  } catch (const std::exception& e) {
+    throw DatasetError("cannot write image '" + path + "': " + e.what());
   }
-  if (!written) throw DatasetError("cannot write image '" + path + "'");
   names_.push_back(name);
   truth_.push_back(toStampedPose(pose, stamp));
 }

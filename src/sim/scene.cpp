@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "oefmt/dataset.h"
 #include "oefmt/error.h"
+#include "oefmt/image_decoding.h"
 #include "oefmt/image_prep.h"
 #include "oefmt/sim/texture.h"
 
@@ -35,7 +35,7 @@ long long floorIndex(double value) { return static_cast<long long>(std::floor(va
 long long floorDivide(long long a, long long b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 cv::Mat1f textureFromFile(const std::string& path) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  const cv::Mat image = readImageFile(path);
   if (image.empty()) throw DatasetError("cannot read texture image '" + path + "'");
   cv::Mat1f grey = toGreyFloat(image);
   const int margin = std::max(4, std::min(grey.cols, grey.rows) / 8);

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <string>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "oefmt/error.h"
 #include "oefmt/image_decoding.h"
