@@ -10,6 +10,8 @@
 #include <memory>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "image_codec_module.h"
 #include "oefmt/error.h"
 
@@ -127,22 +129,23 @@ UnfilterFunction unfilterFor(int bytes_per_pixel) {
   }
 }
 
-// Reconstructed PNG rows -> the cv::Mat OpenCV would give: BGR(A) order, native-endian 16 bit.
-void convertRow(const std::uint8_t* in, int channels, bool sixteen_bit, int width, cv::Mat& image, int y) {
-  if (!sixteen_bit) {
-    std::uint8_t* out = image.ptr<std::uint8_t>(y);
-    if (channels == 1) {
-      std::memcpy(out, in, static_cast<std::size_t>(width));
-      return;
-    }
-    for (int x = 0; x < width; ++x, in += channels, out += channels) {
-      out[0] = in[2];
-      out[1] = in[1];
-      out[2] = in[0];
-      if (channels == 4) out[3] = in[3];
-    }
-    return;
+// Reconstructed 8-bit PNG rows (`stride` bytes apart) -> the cv::Mat OpenCV would give: BGR(A)
+// order. OpenCV's vectorised swap: a per-pixel loop took 0.4 ms of a 512x512 RGB frame.
+cv::Mat convertRows8(const std::uint8_t* first_row, std::size_t stride, int channels, int width,
+                     int height) {
+  const cv::Mat rows(height, width, CV_8UC(channels), const_cast<std::uint8_t*>(first_row), stride);
+  cv::Mat image;
+  if (channels == 1) {
+    rows.copyTo(image);
+  } else {
+    cv::cvtColor(rows, image, channels == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGRA);
   }
+  return image;
+}
+
+// One reconstructed 16-bit PNG row -> row y of the cv::Mat OpenCV would give: BGR(A) order,
+// native-endian.
+void convertRow16(const std::uint8_t* in, int channels, int width, cv::Mat& image, int y) {
   std::uint16_t* out = image.ptr<std::uint16_t>(y);
   auto sample = [in](int i) { return static_cast<std::uint16_t>((in[2 * i] << 8) | in[2 * i + 1]); };
   if (channels == 1) {
@@ -228,16 +231,18 @@ std::optional<cv::Mat> decodePngFast(const std::uint8_t* data, std::size_t size)
   if (inflate_result != LIBDEFLATE_SUCCESS || inflated != filtered_bytes) return std::nullopt;
   const UnfilterFunction unfilter = unfilterFor(bytes_per_pixel);
   if (unfilter == nullptr) return std::nullopt;
-  cv::Mat image(height, width, CV_MAKETYPE(sixteen_bit ? CV_16U : CV_8U, channels));
+  cv::Mat image;
+  if (sixteen_bit) image.create(height, width, CV_MAKETYPE(CV_16U, channels));
   const std::vector<std::uint8_t> zeros(row_bytes, 0);
   const std::uint8_t* previous = zeros.data();
   for (int y = 0; y < height; ++y) {
     std::uint8_t* row = rows.data() + static_cast<std::size_t>(y) * stride;
     if (row[0] > 4) return std::nullopt;  // not a PNG filter type
     unfilter(row[0], row + 1, previous, row_bytes);
-    convertRow(row + 1, channels, sixteen_bit, width, image, y);
+    if (sixteen_bit) convertRow16(row + 1, channels, width, image, y);
     previous = row + 1;
   }
+  if (!sixteen_bit) image = convertRows8(rows.data() + 1, stride, channels, width, height);
   return image;
 }
 
