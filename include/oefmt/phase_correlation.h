@@ -60,7 +60,7 @@ enum class PeakShape {
 /// columns wrap if cyclic_cols. With `stats`, the sums for peakToSidelobeRatio are gathered in
 /// the same pass.
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats = nullptr,
-                     PeakShape shape = PeakShape::kDirichlet);
+                     PeakShape shape = PeakShape::kDirichlet, SimdKernel kernel = SimdKernel::kAuto);
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at

@@ -71,6 +71,20 @@ double widenedPeakOffset(float left, float centre, float right) {
   return weight * sincRatioOffset(left, centre, right) + (1.0 - weight) * centre_of_mass;
 }
 
+// findPeak's per-row pass (the AVX2 kernel computes the same).
+detail::RowStats rowStatsPortable(const float* row, int count) {
+  float row_max = row[0], row_min = row[0], abs_sum = 0.0f, square_sum = 0.0f;
+#pragma omp simd reduction(max : row_max) reduction(min : row_min) reduction(+ : abs_sum, square_sum)
+  for (int c = 0; c < count; ++c) {
+    const float v = row[c];
+    row_max = std::max(row_max, v);
+    row_min = std::min(row_min, v);
+    abs_sum += std::fabs(v);
+    square_sum += v * v;
+  }
+  return {row_max, row_min, abs_sum, square_sum};
+}
+
 }  // namespace
 
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
@@ -118,26 +132,21 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
 }
 
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats,
-                     PeakShape shape) {
+                     PeakShape shape, SimdKernel kernel) {
   if (surface.empty()) throw InputError("findPeak: empty surface");
   // One pass for the extremes and the sums: per row vectorised reductions, and the row is
   // searched for the position only when it holds a new extreme (the first, as cv::minMaxLoc).
   SurfaceStats sums;
   float min_value = surface(0, 0), max_value = surface(0, 0);
   cv::Point min_at, max_at;
+  const bool avx2 = detail::runsAvx2(kernel);
   for (int r = 0; r < surface.rows; ++r) {
     const float* row = surface[r];
-    float row_max = row[0], row_min = row[0], abs_sum = 0.0f, square_sum = 0.0f;
-#pragma omp simd reduction(max : row_max) reduction(min : row_min) reduction(+ : abs_sum, square_sum)
-    for (int c = 0; c < surface.cols; ++c) {
-      const float v = row[c];
-      row_max = std::max(row_max, v);
-      row_min = std::min(row_min, v);
-      abs_sum += std::fabs(v);
-      square_sum += v * v;
-    }
-    sums.abs_sum += abs_sum;
-    sums.square_sum += square_sum;
+    const detail::RowStats row_stats = avx2 ? detail::rowStatsAvx2(row, surface.cols)
+                                            : rowStatsPortable(row, surface.cols);
+    const float row_max = row_stats.max, row_min = row_stats.min;
+    sums.abs_sum += row_stats.abs_sum;
+    sums.square_sum += row_stats.square_sum;
     // (A NaN is never found: column 0 then, as the sums already carry the NaN.)
     auto column_of = [&](float value) {
       const int c = static_cast<int>(std::find(row, row + surface.cols, value) - row);

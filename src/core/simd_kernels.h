@@ -48,5 +48,13 @@ void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
 /// out[i] = |z_i| for `count` interleaved complex values.
 void magnitudeRowAvx2(const float* complex_values, int count, float* out);
 
+/// What findPeak gathers from each surface row: its extremes (a NaN is skipped, as std::max
+/// skips it) and the sums of |v| and v^2 (a NaN carries through).
+struct RowStats {
+  float max, min, abs_sum, square_sum;
+};
+/// The RowStats of `count` >= 1 floats.
+RowStats rowStatsAvx2(const float* row, int count);
+
 }  // namespace detail
 }  // namespace oefmt

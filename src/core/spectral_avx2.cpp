@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// AVX2 + FMA kernels of the per-frequency loops (cross power, magnitude). Compiled with -mavx2 -mfma (CMakeLists.txt) and called only on CPUs that have
+// AVX2 + FMA kernels of the per-frequency loops (cross power, magnitude) and of the surface
+// statistics of the peak search. Compiled with -mavx2 -mfma (CMakeLists.txt) and called only on CPUs that have
 // both; nothing but intrinsics, builtins and plain types in here (see line_sampling_avx2.cpp for why).
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -64,6 +65,41 @@ void magnitudeRowAvx2(const float* complex_values, int count, float* out) {
   }
 }
 
+RowStats rowStatsAvx2(const float* row, int count) {
+  const __m256 sign_bit = _mm256_set1_ps(-0.0f);
+  __m256 maxima = _mm256_set1_ps(row[0]), minima = maxima;
+  __m256 abs_sums = _mm256_setzero_ps(), square_sums = _mm256_setzero_ps();
+  int c = 0;
+  for (; c + 8 <= count; c += 8) {
+    const __m256 v = _mm256_loadu_ps(row + c);
+    // max/min return their second operand when one is NaN: the running value, as std::max.
+    maxima = _mm256_max_ps(v, maxima);
+    minima = _mm256_min_ps(v, minima);
+    abs_sums = _mm256_add_ps(abs_sums, _mm256_andnot_ps(sign_bit, v));
+    square_sums = _mm256_fmadd_ps(v, v, square_sums);
+  }
+  alignas(32) float max_lanes[8], min_lanes[8], abs_lanes[8], square_lanes[8];
+  _mm256_store_ps(max_lanes, maxima);
+  _mm256_store_ps(min_lanes, minima);
+  _mm256_store_ps(abs_lanes, abs_sums);
+  _mm256_store_ps(square_lanes, square_sums);
+  RowStats stats{max_lanes[0], min_lanes[0], 0.0f, 0.0f};
+  for (int lane = 0; lane < 8; ++lane) {
+    stats.max = max_lanes[lane] > stats.max ? max_lanes[lane] : stats.max;
+    stats.min = min_lanes[lane] < stats.min ? min_lanes[lane] : stats.min;
+    stats.abs_sum += abs_lanes[lane];
+    stats.square_sum += square_lanes[lane];
+  }
+  for (; c < count; ++c) {
+    const float v = row[c];
+    stats.max = v > stats.max ? v : stats.max;
+    stats.min = v < stats.min ? v : stats.min;
+    stats.abs_sum += __builtin_fabsf(v);
+    stats.square_sum += v * v;
+  }
+  return stats;
+}
+
 }  // namespace detail
 }  // namespace oefmt
 
@@ -78,6 +114,7 @@ namespace detail {
 
 void crossPowerRowAvx2(const float*, const float*, float*, int, float, float, bool) { std::abort(); }
 void magnitudeRowAvx2(const float*, int, float*) { std::abort(); }
+RowStats rowStatsAvx2(const float*, int) { std::abort(); }
 
 }  // namespace detail
 }  // namespace oefmt

@@ -45,6 +45,40 @@ TEST(SimdKernels, CrossPowerMatchesThePortableLoop) {
   }
 }
 
+TEST(SimdKernels, PeakSearchMatchesThePortableLoop) {
+  // 37 columns: four eight-wide steps and a tail of five; the largest |value| negative once.
+  cv::Mat1f surface(16, 37);
+  cv::RNG(4).fill(surface, cv::RNG::NORMAL, 0.0, 1.0);
+  for (const cv::Point at : {cv::Point(36, 9), cv::Point(3, 5)}) {
+    cv::Mat1f trial = surface.clone();
+    trial(at) = at.x == 3 ? -9.0f : 9.0f;  // in the tail, then a negative one in a step
+    SurfaceStats fast_stats, portable_stats;
+    const SurfacePeak fast = findPeak(trial, true, &fast_stats, PeakShape::kDirichlet, SimdKernel::kAuto);
+    const SurfacePeak portable =
+        findPeak(trial, true, &portable_stats, PeakShape::kDirichlet, SimdKernel::kPortable);
+    EXPECT_EQ(fast.row, at.y);
+    EXPECT_EQ(fast.col, at.x);
+    EXPECT_EQ(fast.row, portable.row);
+    EXPECT_EQ(fast.col, portable.col);
+    EXPECT_EQ(fast.value, portable.value);
+    EXPECT_DOUBLE_EQ(fast.sub_row, portable.sub_row);
+    EXPECT_DOUBLE_EQ(fast.sub_col, portable.sub_col);
+    EXPECT_NEAR(fast_stats.abs_sum, portable_stats.abs_sum, 1e-5 * portable_stats.abs_sum);
+    EXPECT_NEAR(fast_stats.square_sum, portable_stats.square_sum, 1e-5 * portable_stats.square_sum);
+  }
+  // A NaN is never the peak, and the sums carry it.
+  cv::Mat1f with_nan = surface.clone();
+  with_nan(2, 20) = std::nanf("");
+  SurfaceStats fast_stats, portable_stats;
+  const SurfacePeak fast = findPeak(with_nan, true, &fast_stats, PeakShape::kDirichlet, SimdKernel::kAuto);
+  const SurfacePeak portable =
+      findPeak(with_nan, true, &portable_stats, PeakShape::kDirichlet, SimdKernel::kPortable);
+  EXPECT_TRUE(std::isfinite(fast.value));
+  EXPECT_EQ(fast.value, portable.value);
+  EXPECT_TRUE(std::isnan(fast_stats.abs_sum));
+  EXPECT_TRUE(std::isnan(portable_stats.square_sum));
+}
+
 TEST(SimdKernels, MagnitudeMatchesThePortableLoop) {
   const int n = 64;  // 33 stored columns: a tail of one after four eight-wide steps
   const cv::Mat2f spectrum = randomSpectrum(n, n / 2 + 1, 3);
