@@ -18,14 +18,20 @@ namespace oefmt {
 namespace fs = std::filesystem;
 namespace {
 
-// readImageFile with the file named in its errors too (an image over the size limit, no
-// imgcodecs plugin for a format the fast path does not read).
-cv::Mat readNamedImage(const std::string& path) {
+// readImageFile, or a DatasetError naming the file: missing, unreadable or corrupt, over the
+// size limit, or of a format the fast path does not read without the imgcodecs plugin.
+cv::Mat readDatasetImage(const std::string& path) {
+  cv::Mat image;
   try {
-    return readImageFile(path);
+    image = readImageFile(path);
   } catch (const std::exception& e) {
     throw DatasetError("cannot read image '" + path + "': " + e.what());
   }
+  if (image.empty()) {
+    throw DatasetError(fs::exists(path) ? "cannot read image '" + path + "' (not an image or corrupt)"
+                                        : "image '" + path + "' does not exist");
+  }
+  return image;
 }
 
 std::string trim(const std::string& text) {
@@ -180,12 +186,7 @@ FolderDataset::FolderDataset(const std::string& directory) : directory_(director
   readImageList();
   if (names_.empty()) throw DatasetError("dataset '" + directory_ + "' lists no image");
 
-  const cv::Mat first = readNamedImage(paths_[0]);
-  if (first.empty()) {
-    throw DatasetError(fs::exists(paths_[0]) ? "cannot read image '" + paths_[0] + "' (not an image?)"
-                                             : "image '" + paths_[0] + "' does not exist");
-  }
-  image_size_ = first.size();
+  image_size_ = readDatasetImage(paths_[0]).size();
 
   const std::string yaml = (fs::path(directory_) / "cam_param.yaml").string();
   if (!fs::exists(yaml)) throw DatasetError("dataset '" + directory_ + "' has no cam_param.yaml");
@@ -273,11 +274,7 @@ double FolderDataset::timestamp(std::size_t index) const {
 
 cv::Mat FolderDataset::loadImage(std::size_t index) const {
   const std::string& path = imagePath(index);
-  cv::Mat image = readNamedImage(path);
-  if (image.empty()) {
-    throw DatasetError(fs::exists(path) ? "cannot read image '" + path + "' (not an image or corrupt)"
-                                        : "image '" + path + "' does not exist");
-  }
+  cv::Mat image = readDatasetImage(path);
   if (image.size() != image_size_) {
     throw DatasetError("image '" + path + "' is " + sizeText(image.size()) + " but the dataset's images are " +
                        sizeText(image_size_));

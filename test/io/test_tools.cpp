@@ -45,6 +45,13 @@ ToolRun run(const TempDir& dir, const std::string& command) {
   return result;
 }
 
+// A 3-frame 128 x 128 flight in dir/flight (PNG images, ground truth, cam_param.yaml).
+void simulateThreeFrames(const TempDir& dir) {
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
+                                    (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+}
+
 TEST(Tools, SimulateConvertAndEvaluate) {
   TempDir dir;
   const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --size 96 --frames 6 --length 15 --seed 3 --bag " +
@@ -158,9 +165,7 @@ TEST(Tools, OfflineKeepsTheTrajectoryOnBadInput) {
 // size to set; with that size, none.
 TEST(Tools, OfflineWarnsWhenFramesAreUpscaled) {
   TempDir dir;
-  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
-                                    (dir / "flight"));
-  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
   const ToolRun upscaled = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
                                         " --output " + (dir / "a.tum"));
   EXPECT_EQ(upscaled.status, 0) << upscaled.err;
@@ -181,9 +186,7 @@ TEST(Tools, OfflineWarnsWhenFramesAreUpscaled) {
 // plugin beside liboefmt_core.so; and without the plugin, a clear error.
 TEST(Tools, OfflineLoadsImgcodecsOnlyForImagesThatNeedIt) {
   TempDir dir;
-  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
-                                    (dir / "flight"));
-  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
   // LD_DEBUG=files: the dynamic loader names every library it loads (on stderr).
   const std::string offline = std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") + " --output ";
   const ToolRun png = run(dir, "env LD_DEBUG=files " + offline + (dir / "png.tum"));
@@ -219,9 +222,7 @@ TEST(Tools, OfflineLoadsImgcodecsOnlyForImagesThatNeedIt) {
 // A folder of tiny (40 x 30) frames: a clear message with the size, exit status 1.
 TEST(Tools, OfflineRefusesTinyFrames) {
   TempDir dir;
-  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
-                                    (dir / "flight"));
-  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
   for (const char* name : {"0001.png", "0002.png", "0003.png"}) {
     const std::string path = dir / (std::string("flight/Images/") + name);
     ASSERT_TRUE(std::ifstream(path).good()) << path;
