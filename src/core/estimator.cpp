@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <future>
 #include <limits>
 #include <string>
@@ -11,6 +12,7 @@
 #include "estimator_measurements.h"
 #include "oefmt/error.h"
 #include "oefmt/multi_zoom.h"
+#include "worker_thread.h"
 
 namespace oefmt {
 namespace {
@@ -118,6 +120,30 @@ struct Estimator::State {
   std::optional<PairMotion> last_step;  // the last motion per frame interval
   bool started = false;
   double last_stamp = -std::numeric_limits<double>::infinity();
+
+  // Runs pair 0-2. Last: destroyed (its task finished) before the frames and the registrar
+  // that task reads.
+  detail::WorkerThread worker02;
+};
+
+// While pair 0-2 runs on the worker it reads the newest frame, a local of Estimator::push: an
+// exception that leaves push early must first wait for it.
+class PendingPairGuard {
+ public:
+  explicit PendingPairGuard(std::future<PairRegistration>& pending)
+      : pending_(pending), exceptions_(std::uncaught_exceptions()) {}
+  ~PendingPairGuard() {
+    if (std::uncaught_exceptions() > exceptions_ && pending_.valid()) {
+      pending_.wait();
+      pending_ = {};
+    }
+  }
+  PendingPairGuard(const PendingPairGuard&) = delete;
+  PendingPairGuard& operator=(const PendingPairGuard&) = delete;
+
+ private:
+  std::future<PairRegistration>& pending_;
+  int exceptions_;
 };
 
 cv::Matx44d Estimator::State::heldGrowth() const {
@@ -382,10 +408,11 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       // if pair 1-2 fails.
       const FrameSpectra& older = s.f0->spectra;
       const FrameSpectra& newer = frame.spectra;
-      s.pending02 = std::async(std::launch::async, [&s, &older, &newer] {
+      s.pending02 = s.worker02.submit([&s, &older, &newer] {
         return s.registrar02.registerPair(older, newer);
       });
     }
+    const PendingPairGuard pending_guard(s.pending02);
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces);

@@ -149,6 +149,19 @@ TEST_P(FastPngLayouts, EveryFilterGivesOpenCvsPixels) {
 INSTANTIATE_TEST_SUITE_P(DepthsAndChannels, FastPngLayouts,
                          ::testing::Values(CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4));
 
+TEST(FastPng, NarrowRowsUnfilterExactly) {
+  // Rows of one pixel and a few: the filters' left neighbour falls outside the row at first.
+  for (const int type : {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1, CV_16UC3, CV_16UC4}) {
+    for (int width = 1; width <= 12; ++width) {
+      const cv::Mat image = noise(6, width, type, 100 * type + width);
+      const Bytes png = encodePng(image);
+      const std::optional<cv::Mat> fast = decodePngFast(png.data(), png.size());
+      ASSERT_TRUE(fast.has_value()) << "type " << type << " width " << width;
+      expectIdentical(image, *fast);
+    }
+  }
+}
+
 TEST(FastPng, OpenCvsOwnWriterAtEveryCompressionLevel) {
   const cv::Mat image = noise(64, 80, CV_8UC3, 7);
   cv::Mat smooth;
