@@ -4,6 +4,7 @@
 // path), and where its fast PNG decoder answers, the answer must equal cv::imdecode's; anything
 // else is read as a raw image: a header byte picks the pixel type, two more the size, and the
 // rest are the pixels (float types take the bytes as bit patterns: NaN, inf, denormals).
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <optional>
@@ -56,6 +57,10 @@ void checkPrepared(const oefmt::PreparedImage& prepared, const cv::Mat& image) {
   checkFinite(prepared.grey, "prepared grey finite");
   checkFinite(prepared.texture, "prepared texture finite");
   check(prepared.texture >= 0.0, "prepared texture >= 0", prepared.texture);
+  checkFinite(prepared.mean, "prepared mean finite");
+  checkFinite(prepared.largest_magnitude, "prepared largest |value| finite");
+  check(prepared.largest_magnitude >= std::abs(prepared.mean) * (1.0 - 1e-6),
+        "largest |value| >= |mean|", prepared.largest_magnitude);
   check(prepared.invalid_pixels >= 0 &&
             static_cast<size_t>(prepared.invalid_pixels) <= image.total(),
         "invalid pixel count in range", prepared.invalid_pixels);

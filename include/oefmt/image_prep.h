@@ -2,6 +2,8 @@
 // Image preparation: any camera image -> grey float, centre-cropped square of N x N pixels.
 #pragma once
 
+#include <limits>
+
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -27,6 +29,10 @@ struct PreparedImage {
   cv::Mat1f grey;          ///< size x size, intensities in [0, 1] for integer inputs
   int invalid_pixels = 0;  ///< NaN/inf pixels of the input, replaced by the mean of the valid ones
   double texture = 0.0;    ///< standard deviation of grey (0 for constant or black frames)
+  /// Mean and largest |value| of grey, taken by prepareImage in the pass that gives the texture
+  /// (the spectra need both); NaN when unknown (an image prepared elsewhere): computed then.
+  double mean = std::numeric_limits<double>::quiet_NaN();
+  double largest_magnitude = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Converts any 1/3/4-channel 8-bit, 16-bit, 32-bit or 64-bit float image to single-channel float.

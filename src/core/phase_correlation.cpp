@@ -71,20 +71,6 @@ double widenedPeakOffset(float left, float centre, float right) {
   return weight * sincRatioOffset(left, centre, right) + (1.0 - weight) * centre_of_mass;
 }
 
-// findPeak's per-row pass (the AVX2 kernel computes the same).
-detail::RowStats rowStatsPortable(const float* row, int count) {
-  float row_max = row[0], row_min = row[0], abs_sum = 0.0f, square_sum = 0.0f;
-#pragma omp simd reduction(max : row_max) reduction(min : row_min) reduction(+ : abs_sum, square_sum)
-  for (int c = 0; c < count; ++c) {
-    const float v = row[c];
-    row_max = std::max(row_max, v);
-    row_min = std::min(row_min, v);
-    abs_sum += std::fabs(v);
-    square_sum += v * v;
-  }
-  return {row_max, row_min, abs_sum, square_sum};
-}
-
 }  // namespace
 
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
@@ -126,9 +112,13 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
                   1.0f, false, SimdKernel::kAuto);
   }
   small.inverse(scratch_spectrum, scratch_surface);
-  double min_value = 0.0, max_value = 0.0;
-  cv::minMaxLoc(scratch_surface, &min_value, &max_value);
-  return std::max(max_value, -min_value) / (static_cast<double>(m) * m);
+  // The largest |value| (cv::minMaxLoc also tracked both positions: 4x slower).
+  float largest = 0.0f;
+  const float* values = scratch_surface.ptr<float>();
+  const int count = static_cast<int>(scratch_surface.total());
+#pragma omp simd reduction(max : largest)
+  for (int i = 0; i < count; ++i) largest = std::max(largest, std::fabs(values[i]));
+  return largest / (static_cast<double>(m) * m);
 }
 
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats,
@@ -142,8 +132,7 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
   const bool avx2 = detail::runsAvx2(kernel);
   for (int r = 0; r < surface.rows; ++r) {
     const float* row = surface[r];
-    const detail::RowStats row_stats = avx2 ? detail::rowStatsAvx2(row, surface.cols)
-                                            : rowStatsPortable(row, surface.cols);
+    const detail::RowStats row_stats = detail::rowStats(row, surface.cols, avx2);
     const float row_max = row_stats.max, row_min = row_stats.min;
     sums.abs_sum += row_stats.abs_sum;
     sums.square_sum += row_stats.square_sum;

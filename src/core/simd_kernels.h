@@ -48,13 +48,17 @@ void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
 /// out[i] = |z_i| for `count` interleaved complex values.
 void magnitudeRowAvx2(const float* complex_values, int count, float* out);
 
-/// What findPeak gathers from each surface row: its extremes (a NaN is skipped, as std::max
-/// skips it) and the sums of |v| and v^2 (a NaN carries through).
+/// What findPeak and prepareImage gather from each row: its extremes (a NaN is skipped, as
+/// std::max skips it) and the sums of v, |v| and v^2 (a NaN carries through).
 struct RowStats {
-  float max, min, abs_sum, square_sum;
+  float max, min, sum, abs_sum, square_sum;
 };
 /// The RowStats of `count` >= 1 floats.
-RowStats rowStatsAvx2(const float* row, int count);
+RowStats rowStatsPortable(const float* row, int count);  // row_stats.cpp
+RowStats rowStatsAvx2(const float* row, int count);      // spectral_avx2.cpp
+static inline RowStats rowStats(const float* row, int count, bool avx2) {
+  return avx2 ? rowStatsAvx2(row, count) : rowStatsPortable(row, count);
+}
 
 }  // namespace detail
 }  // namespace oefmt

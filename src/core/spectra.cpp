@@ -154,17 +154,23 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   // Float frames keep their values, and single-precision spectra overflow (or the normalised
   // cross power drops frequencies) far below FLT_MAX: scale such frames down. Every correlation
   // is normalised, so a frame's intensity scale does not change its registration.
-  double low = 0.0, high = 0.0;
-  cv::minMaxLoc(frame.grey, &low, &high);
-  const double largest = std::max(-low, high);
+  double largest = image.largest_magnitude;
+  if (std::isnan(largest)) {
+    double low = 0.0, high = 0.0;
+    cv::minMaxLoc(frame.grey, &low, &high);
+    largest = std::max(-low, high);
+  }
+  bool scaled_down = false;
   if (largest > kMaxSpectralIntensity && std::isfinite(largest)) {
     cv::Mat1f scaled;  // a new buffer: frame.grey may share the caller's pixels
     frame.grey.convertTo(scaled, CV_32F, kMaxSpectralIntensity / largest);
     frame.grey = scaled;
+    scaled_down = true;
   }
   frame.texture = image.texture;
   frame.invalid_pixels = image.invalid_pixels;
-  frame.mean = static_cast<float>(cv::mean(frame.grey)[0]);
+  const bool mean_known = !std::isnan(image.mean) && !scaled_down;
+  frame.mean = static_cast<float>(mean_known ? image.mean : cv::mean(frame.grey)[0]);
   // Both images are written straight into their spectra's buffers (in-place FFTs).
   const Fft2d& fft = context_->fft();
   cv::Mat1f windowed = fft.inPlaceInput(frame.spectrum);

@@ -88,25 +88,28 @@ void magnitudeRowAvx2(const float* complex_values, int count, float* out) {
 RowStats rowStatsAvx2(const float* row, int count) {
   const __m256 sign_bit = _mm256_set1_ps(-0.0f);
   __m256 maxima = _mm256_set1_ps(row[0]), minima = maxima;
-  __m256 abs_sums = _mm256_setzero_ps(), square_sums = _mm256_setzero_ps();
+  __m256 sums = _mm256_setzero_ps(), abs_sums = _mm256_setzero_ps(), square_sums = _mm256_setzero_ps();
   int c = 0;
   for (; c + 8 <= count; c += 8) {
     const __m256 v = _mm256_loadu_ps(row + c);
     // max/min return their second operand when one is NaN: the running value, as std::max.
     maxima = _mm256_max_ps(v, maxima);
     minima = _mm256_min_ps(v, minima);
+    sums = _mm256_add_ps(sums, v);
     abs_sums = _mm256_add_ps(abs_sums, _mm256_andnot_ps(sign_bit, v));
     square_sums = _mm256_fmadd_ps(v, v, square_sums);
   }
-  alignas(32) float max_lanes[8], min_lanes[8], abs_lanes[8], square_lanes[8];
+  alignas(32) float max_lanes[8], min_lanes[8], sum_lanes[8], abs_lanes[8], square_lanes[8];
   _mm256_store_ps(max_lanes, maxima);
   _mm256_store_ps(min_lanes, minima);
+  _mm256_store_ps(sum_lanes, sums);
   _mm256_store_ps(abs_lanes, abs_sums);
   _mm256_store_ps(square_lanes, square_sums);
-  RowStats stats{max_lanes[0], min_lanes[0], 0.0f, 0.0f};
+  RowStats stats{max_lanes[0], min_lanes[0], 0.0f, 0.0f, 0.0f};
   for (int lane = 0; lane < 8; ++lane) {
     stats.max = max_lanes[lane] > stats.max ? max_lanes[lane] : stats.max;
     stats.min = min_lanes[lane] < stats.min ? min_lanes[lane] : stats.min;
+    stats.sum += sum_lanes[lane];
     stats.abs_sum += abs_lanes[lane];
     stats.square_sum += square_lanes[lane];
   }
@@ -114,6 +117,7 @@ RowStats rowStatsAvx2(const float* row, int count) {
     const float v = row[c];
     stats.max = v > stats.max ? v : stats.max;
     stats.min = v < stats.min ? v : stats.min;
+    stats.sum += v;
     stats.abs_sum += __builtin_fabsf(v);
     stats.square_sum += v * v;
   }

@@ -4,6 +4,7 @@
 // handling of vanished values. (On a CPU without AVX2 both sides are the portable code.)
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "oefmt/fft.h"
@@ -11,6 +12,7 @@
 #include "oefmt/config.h"
 #include "oefmt/error.h"
 #include "oefmt/spectra.h"
+#include "simd_kernels.h"
 
 namespace oefmt {
 namespace {
@@ -45,6 +47,28 @@ TEST(SimdKernels, CrossPowerMatchesThePortableLoop) {
     // The centring sign alternates with the column (and the row).
     EXPECT_NEAR(fast_centred(2, 1)[0], -fast(2, 1)[0] / (16.0 * 16.0), 1e-9);
     EXPECT_NEAR(fast_centred(3, 1)[0], fast(3, 1)[0] / (16.0 * 16.0), 1e-9);
+  }
+}
+
+TEST(SimdKernels, RowStatisticsMatchThePortableLoop) {
+  // 37 floats: four eight-wide steps and a tail of five; negative values for sum vs |sum|.
+  cv::Mat1f row(1, 37);
+  cv::RNG(8).fill(row, cv::RNG::NORMAL, 0.1, 1.0);
+  row(0, 35) = -7.0f;  // the minimum, in the tail
+  const detail::RowStats fast = detail::rowStats(row[0], row.cols, detail::runsAvx2(SimdKernel::kAuto));
+  const detail::RowStats portable = detail::rowStatsPortable(row[0], row.cols);
+  double sum = 0.0, abs_sum = 0.0, square_sum = 0.0;
+  for (const float v : row) {
+    sum += v;
+    abs_sum += std::fabs(v);
+    square_sum += double(v) * v;
+  }
+  for (const detail::RowStats& stats : {fast, portable}) {
+    EXPECT_EQ(stats.min, -7.0f);
+    EXPECT_EQ(stats.max, *std::max_element(row.begin(), row.end()));
+    EXPECT_NEAR(stats.sum, sum, 1e-5 * abs_sum);
+    EXPECT_NEAR(stats.abs_sum, abs_sum, 1e-5 * abs_sum);
+    EXPECT_NEAR(stats.square_sum, square_sum, 1e-5 * square_sum);
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "oefmt/error.h"
 #include "oefmt/fft.h"
@@ -239,6 +240,34 @@ TEST(Spectra, AFramesSpectraDoNotDependOnTheBuildersHistory) {
   EXPECT_TRUE(same(a.grey, b.grey));
   EXPECT_TRUE(same(a.spectrum, b.spectrum));
   EXPECT_TRUE(same(a.log_polar_spectrum, b.log_polar_spectrum));
+}
+
+TEST(Spectra, ThePreparedImagesStatisticsAreTheImagesOwn) {
+  // prepareImage hands the spectra the mean and the largest |value| of its one pass; an image
+  // prepared elsewhere (unknown: NaN) gets them computed: the same spectra either way.
+  cv::Mat1f image(128, 128);
+  cv::RNG(3).fill(image, cv::RNG::UNIFORM, -0.2, 0.9);
+  image(70, 33) = -1.5f;  // the largest |value| is negative
+  const PreparedImage prepared = prepareImage(image, 128);
+  double low = 0.0, high = 0.0;
+  cv::minMaxLoc(prepared.grey, &low, &high);
+  EXPECT_EQ(prepared.largest_magnitude, 1.5);
+  EXPECT_EQ(prepared.largest_magnitude, std::max(-low, high));
+  EXPECT_NEAR(prepared.mean, cv::mean(prepared.grey)[0], 1e-7);  // float row sums
+
+  PreparedImage unknown = prepared;
+  unknown.mean = unknown.largest_magnitude = std::numeric_limits<double>::quiet_NaN();
+  SpectraBuilder builder(test::sharedContext(128));
+  const FrameSpectra known_stats = builder.build(prepared), computed = builder.build(unknown);
+  EXPECT_NEAR(known_stats.mean, computed.mean, 1e-7);
+  EXPECT_LT(cv::norm(known_stats.spectrum, computed.spectrum, cv::NORM_INF),
+            1e-5 * cv::norm(computed.spectrum, cv::NORM_INF));
+
+  // A float frame far brighter than the spectra take is scaled down, and its mean with it.
+  const PreparedImage bright = prepareImage(cv::Mat1f(image * 1e6f), 128);
+  EXPECT_NEAR(bright.largest_magnitude, 1.5e6, 1.0);
+  const FrameSpectra scaled = builder.build(bright);
+  EXPECT_NEAR(scaled.mean, computed.mean * 1024.0 / 1.5, 1e-4);
 }
 
 }  // namespace
