@@ -3,7 +3,6 @@
 #pragma once
 
 #include <limits>
-
 #include <string>
 
 #include <opencv2/core.hpp>

@@ -49,7 +49,7 @@ struct PixelMoments {
 };
 
 // Mean, mean square and largest |pixel| in one pass of vectorised row statistics (float per row,
-// double over rows; cv::sum, cv::norm, cv::mean and cv::minMaxLoc took four passes, 0.45 ms at
+// double over rows; cv::sum, cv::norm, cv::mean and cv::minMaxLoc took four passes, 0.4 ms at
 // 512^2). Squares of huge float pixels overflow a float row sum: double sums then.
 PixelMoments pixelMoments(const cv::Mat1f& grey) {
   const bool avx2 = detail::runsAvx2(SimdKernel::kAuto);

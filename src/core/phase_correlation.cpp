@@ -112,12 +112,16 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
                   1.0f, false, SimdKernel::kAuto);
   }
   small.inverse(scratch_spectrum, scratch_surface);
-  // The largest |value|, from the vectorised row statistics of the whole (continuous) surface:
-  // cv::minMaxLoc also tracked both positions.
-  const detail::RowStats stats =
-      detail::rowStats(scratch_surface.ptr<float>(), static_cast<int>(scratch_surface.total()),
-                       detail::runsAvx2(SimdKernel::kAuto));
-  return std::max(stats.max, -stats.min) / (static_cast<double>(m) * m);
+  // The largest |value|, from the vectorised row statistics (cv::minMaxLoc also tracked both
+  // positions).
+  const bool avx2 = detail::runsAvx2(SimdKernel::kAuto);
+  float high = scratch_surface(0, 0), low = high;
+  for (int r = 0; r < scratch_surface.rows; ++r) {
+    const detail::RowStats stats = detail::rowStats(scratch_surface[r], scratch_surface.cols, avx2);
+    high = std::max(high, stats.max);
+    low = std::min(low, stats.min);
+  }
+  return std::max(high, -low) / (static_cast<double>(m) * m);
 }
 
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats,
