@@ -52,16 +52,10 @@ struct PixelMoments {
 // double over rows; cv::sum, cv::norm, cv::mean and cv::minMaxLoc took four passes, 0.4 ms at
 // 512^2). Squares of huge float pixels overflow a float row sum: double sums then.
 PixelMoments pixelMoments(const cv::Mat1f& grey) {
-  const bool avx2 = detail::runsAvx2(SimdKernel::kAuto);
-  double sum = 0.0, square_sum = 0.0;
-  float high = grey(0, 0), low = grey(0, 0);
-  for (int r = 0; r < grey.rows; ++r) {
-    const detail::RowStats row = detail::rowStats(grey[r], grey.cols, avx2);
-    sum += row.sum;
-    square_sum += row.square_sum;
-    high = std::max(high, row.max);
-    low = std::min(low, row.min);
-  }
+  const detail::SurfaceTotals totals =
+      detail::surfaceTotals(grey[0], static_cast<int>(grey.step1()), grey.rows, grey.cols,
+                            detail::runsAvx2(SimdKernel::kAuto));
+  double sum = totals.sum, square_sum = totals.square_sum;
   if (!std::isfinite(square_sum)) {
     sum = square_sum = 0.0;
     for (int r = 0; r < grey.rows; ++r) {
@@ -78,7 +72,8 @@ PixelMoments pixelMoments(const cv::Mat1f& grey) {
     }
   }
   const double count = static_cast<double>(grey.total());
-  return {sum / count, square_sum / count, std::max(static_cast<double>(high), -static_cast<double>(low))};
+  return {sum / count, square_sum / count,
+          std::max(static_cast<double>(totals.max), -static_cast<double>(totals.min))};
 }
 
 }  // namespace

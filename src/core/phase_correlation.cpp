@@ -114,14 +114,10 @@ double lowResolutionPeak(const cv::Mat2f& newer, const cv::Mat2f& older, bool ha
   small.inverse(scratch_spectrum, scratch_surface);
   // The largest |value|, from the vectorised row statistics (cv::minMaxLoc also tracked both
   // positions).
-  const bool avx2 = detail::runsAvx2(SimdKernel::kAuto);
-  float high = scratch_surface(0, 0), low = high;
-  for (int r = 0; r < scratch_surface.rows; ++r) {
-    const detail::RowStats stats = detail::rowStats(scratch_surface[r], scratch_surface.cols, avx2);
-    high = std::max(high, stats.max);
-    low = std::min(low, stats.min);
-  }
-  return std::max(high, -low) / (static_cast<double>(m) * m);
+  const detail::SurfaceTotals totals = detail::surfaceTotals(
+      scratch_surface[0], static_cast<int>(scratch_surface.step1()), scratch_surface.rows,
+      scratch_surface.cols, detail::runsAvx2(SimdKernel::kAuto));
+  return std::max(totals.max, -totals.min) / (static_cast<double>(m) * m);
 }
 
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats,

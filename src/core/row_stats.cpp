@@ -2,6 +2,7 @@
 // The portable per-row statistics (the AVX2 kernel in spectral_avx2.cpp computes the same).
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "simd_kernels.h"
 
@@ -20,6 +21,19 @@ RowStats rowStatsPortable(const float* row, int count) {
     square_sum += v * v;
   }
   return {row_max, row_min, sum, abs_sum, square_sum};
+}
+
+SurfaceTotals surfaceTotals(const float* first_row, int stride, int rows, int cols, bool avx2) {
+  SurfaceTotals totals{first_row[0], first_row[0], 0.0, 0.0, 0.0};
+  for (int r = 0; r < rows; ++r) {
+    const RowStats row = rowStats(first_row + static_cast<std::ptrdiff_t>(r) * stride, cols, avx2);
+    totals.max = std::max(totals.max, row.max);
+    totals.min = std::min(totals.min, row.min);
+    totals.sum += row.sum;
+    totals.abs_sum += row.abs_sum;
+    totals.square_sum += row.square_sum;
+  }
+  return totals;
 }
 
 }  // namespace detail

@@ -59,6 +59,13 @@ RowStats rowStatsAvx2(const float* row, int count);      // spectral_avx2.cpp
 static inline RowStats rowStats(const float* row, int count, bool avx2) {
   return avx2 ? rowStatsAvx2(row, count) : rowStatsPortable(row, count);
 }
+/// The RowStats of `rows` rows of `cols` >= 1 floats, `stride` floats apart, combined: the
+/// extremes, and the rows' sums added in double.
+struct SurfaceTotals {
+  float max, min;
+  double sum, abs_sum, square_sum;
+};
+SurfaceTotals surfaceTotals(const float* first_row, int stride, int rows, int cols, bool avx2);  // row_stats.cpp
 
 }  // namespace detail
 }  // namespace oefmt
