@@ -12,6 +12,7 @@ if(TARGET oefmt_io_tests)
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"
     OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>"
     OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>"
-    OEFMT_CORE_LIBRARY="$<TARGET_FILE:oefmt_core>")
+    OEFMT_CORE_LIBRARY="$<TARGET_FILE:oefmt_core>"
+    OEFMT_MEASURE_SPEED="${PROJECT_SOURCE_DIR}/scripts/measure_speed.py")
   add_dependencies(oefmt_io_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline)
 endif()

@@ -234,5 +234,26 @@ TEST(Tools, OfflineRefusesTinyFrames) {
   EXPECT_NE(tiny.err.find("0001.png: image of 40x30"), std::string::npos) << tiny.err;
 }
 
+// scripts/measure_speed.py: a line with the figures of each run, the summaries, and a clear
+// error when there is no oefmt_offline to run.
+TEST(Tools, MeasureSpeedReportsEveryRun) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const std::string script = std::string("python3 ") + OEFMT_MEASURE_SPEED;
+  const ToolRun speed = run(dir, script + " --offline " + OEFMT_OFFLINE + " --runs 2 --images " +
+                                     (dir / "flight"));
+  ASSERT_EQ(speed.status, 0) << speed.err;
+  for (const char* expected : {"run 1: ", "run 2: ", "ms per frame (3 frames), CPU ", "peak memory ",
+                               "all runs: 2 runs, median ", "runs with steal below 2 %: "}) {
+    EXPECT_NE(speed.out.find(expected), std::string::npos) << expected << " in\n" << speed.out;
+  }
+  EXPECT_EQ(speed.out.find("run 3: "), std::string::npos) << speed.out;
+
+  const ToolRun missing = run(dir, script + " --offline " + (dir / "none") + " --images " + (dir / "flight"));
+  EXPECT_NE(missing.status, 0);
+  EXPECT_NE(missing.err.find("no executable oefmt_offline at " + (dir / "none")), std::string::npos)
+      << missing.err;
+}
+
 }  // namespace
 }  // namespace oefmt
