@@ -21,7 +21,9 @@ import tempfile
 TIMED_RUN = """
 import resource, subprocess, sys, time
 start = time.perf_counter()
-subprocess.run(sys.argv[1:], check=True)
+status = subprocess.run(sys.argv[1:]).returncode
+if status != 0:
+    sys.exit(status)
 wall = time.perf_counter() - start
 usage = resource.getrusage(resource.RUSAGE_CHILDREN)
 print(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss)
@@ -47,9 +49,12 @@ def frame_count(trajectory_path):
 def timed_run(command):
     """wall s, CPU s, peak resident kB of one run, and the hypervisor's share meanwhile."""
     before = cpu_ticks()
-    result = subprocess.run([sys.executable, "-c", TIMED_RUN] + command, check=True,
-                            capture_output=True, text=True)
+    result = subprocess.run([sys.executable, "-c", TIMED_RUN] + command, capture_output=True,
+                            text=True)
     after = cpu_ticks()
+    if result.returncode != 0:
+        sys.exit(f"measure_speed: oefmt_offline failed (exit status {result.returncode}):\n"
+                 f"{result.stderr.strip()}")
     wall, cpu, peak_kb = result.stdout.split()[-3:]
     steal = None
     if before and after and after[1] > before[1]:

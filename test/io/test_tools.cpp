@@ -253,6 +253,13 @@ TEST(Tools, MeasureSpeedReportsEveryRun) {
   EXPECT_NE(missing.status, 0);
   EXPECT_NE(missing.err.find("no executable oefmt_offline at " + (dir / "none")), std::string::npos)
       << missing.err;
+
+  // A run that fails: its exit status and oefmt_offline's own message, no Python traceback.
+  const ToolRun failed = run(dir, script + " --offline " + OEFMT_OFFLINE + " --images " + (dir / "nowhere"));
+  EXPECT_NE(failed.status, 0);
+  EXPECT_NE(failed.err.find("measure_speed: oefmt_offline failed (exit status "), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("nowhere"), std::string::npos) << failed.err;
+  EXPECT_EQ(failed.err.find("Traceback"), std::string::npos) << failed.err;
 }
 
 }  // namespace
