@@ -3,9 +3,10 @@
 # test/unit into oefmt_unit_tests by CMakeLists.txt.
 
 catkin_add_gtest(oefmt_io_tests test/io/test_bag_io.cpp test/io/test_tools.cpp
-                 test/io/test_debug_rendering.cpp test/support/gtest_main.cpp)
+                 test/io/test_debug_rendering.cpp test/io/test_frame_source.cpp
+                 src/tools/frame_source.cpp test/support/gtest_main.cpp)
 if(TARGET oefmt_io_tests)
-  target_include_directories(oefmt_io_tests PRIVATE test)
+  target_include_directories(oefmt_io_tests PRIVATE test src/tools)
   target_link_libraries(oefmt_io_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_core opencv_imgcodecs)
   target_compile_definitions(oefmt_io_tests PRIVATE
     OEFMT_SIMULATE="$<TARGET_FILE:oefmt_simulate>"

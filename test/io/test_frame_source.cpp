@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// oefmt_offline's PrefetchingSource: frames arrive in order, each with its own spectra; an error
+// while reading or analysing a frame arrives after the frames before it, named; the reader stops
+// there and when the consumer stops early.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+#include <string>
+
+#include "frame_source.h"
+#include "oefmt/error.h"
+
+namespace oefmt {
+namespace {
+
+// Frame k is a 1 x 1 image holding k; `failing_frame` makes next() throw there.
+class CountingSource : public FrameSource {
+ public:
+  CountingSource(std::size_t frames, std::size_t failing_frame, std::atomic<std::size_t>* read)
+      : frames_(frames), failing_frame_(failing_frame), read_(read) {}
+  std::size_t size() const override { return frames_; }
+  bool next(SourceFrame& frame) override {
+    if (index_ >= frames_) return false;
+    if (index_ == failing_frame_) throw InputError("frame " + std::to_string(index_) + " is corrupt");
+    frame.index = index_;
+    frame.stamp = 0.1 * static_cast<double>(index_);
+    frame.name = "f" + std::to_string(index_);
+    frame.image = cv::Mat1f(1, 1, static_cast<float>(index_));
+    ++index_;
+    if (read_ != nullptr) ++*read_;
+    return true;
+  }
+  Intrinsics intrinsics() const override { return Intrinsics{}; }
+  std::string describe() const override { return "counting"; }
+
+ private:
+  std::size_t frames_;
+  std::size_t failing_frame_;
+  std::atomic<std::size_t>* read_;
+  std::size_t index_ = 0;
+};
+
+constexpr std::size_t kNever = static_cast<std::size_t>(-1);
+
+// The analysis records the image's value as the texture; `failing_value` makes it throw.
+PrefetchingSource::Analyse recordingAnalysis(float failing_value = -1.0f) {
+  return [failing_value](const cv::Mat& image) {
+    const float value = image.at<float>(0, 0);
+    if (value == failing_value) throw InputError("cannot analyse this image");
+    FrameSpectra spectra;
+    spectra.texture = value;
+    return spectra;
+  };
+}
+
+TEST(PrefetchingSource, DeliversEveryFrameInOrderWithItsOwnSpectra) {
+  PrefetchingSource source(std::make_unique<CountingSource>(50, kNever, nullptr), 2, recordingAnalysis());
+  SourceFrame frame;
+  std::size_t count = 0;
+  while (source.next(frame)) {
+    EXPECT_EQ(frame.index, count);
+    EXPECT_DOUBLE_EQ(frame.spectra.texture, static_cast<double>(count));
+    EXPECT_TRUE(frame.image.empty());  // released once analysed
+    EXPECT_EQ(frame.image_size, cv::Size(1, 1));
+    ++count;
+  }
+  EXPECT_EQ(count, 50u);
+  EXPECT_FALSE(source.next(frame));  // and stays at the end
+}
+
+TEST(PrefetchingSource, WithoutAnalysisDeliversTheImages) {
+  PrefetchingSource source(std::make_unique<CountingSource>(5, kNever, nullptr), 3);
+  SourceFrame frame;
+  for (std::size_t k = 0; k < 5; ++k) {
+    ASSERT_TRUE(source.next(frame));
+    ASSERT_FALSE(frame.image.empty());
+    EXPECT_FLOAT_EQ(frame.image.at<float>(0, 0), static_cast<float>(k));
+    EXPECT_TRUE(frame.spectra.empty());
+  }
+  EXPECT_FALSE(source.next(frame));
+}
+
+TEST(PrefetchingSource, DecodingErrorArrivesAfterTheFramesBeforeIt) {
+  PrefetchingSource source(std::make_unique<CountingSource>(20, 7, nullptr), 2, recordingAnalysis());
+  SourceFrame frame;
+  for (std::size_t k = 0; k < 7; ++k) {
+    ASSERT_TRUE(source.next(frame));
+    EXPECT_EQ(frame.index, k);
+  }
+  try {
+    source.next(frame);
+    FAIL() << "no error after frame 6";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "frame 7 is corrupt");
+  }
+}
+
+TEST(PrefetchingSource, AnalysisErrorNamesTheFrameAndStopsThere) {
+  std::atomic<std::size_t> read{0};
+  PrefetchingSource source(std::make_unique<CountingSource>(20, kNever, &read), 2, recordingAnalysis(5.0f));
+  SourceFrame frame;
+  for (std::size_t k = 0; k < 5; ++k) {
+    ASSERT_TRUE(source.next(frame));
+    EXPECT_EQ(frame.index, k);
+  }
+  try {
+    source.next(frame);
+    FAIL() << "no error at frame 5";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "f5: cannot analyse this image");
+  }
+  EXPECT_LT(read.load(), 20u);  // the reader stopped there, not reading the whole source
+}
+
+TEST(PrefetchingSource, StoppingEarlyDoesNotWaitForTheRest) {
+  std::atomic<std::size_t> read{0};
+  {
+    PrefetchingSource source(std::make_unique<CountingSource>(1000000, kNever, &read), 2, recordingAnalysis());
+    SourceFrame frame;
+    ASSERT_TRUE(source.next(frame));
+    ASSERT_TRUE(source.next(frame));
+  }  // destroyed with both threads mid-stream: returns (a hang would time the test out)
+  EXPECT_LT(read.load(), 100u);  // bounded read-ahead: a few frames, not the source
+}
+
+}  // namespace
+}  // namespace oefmt
