@@ -81,35 +81,30 @@ TEST(PrefetchingSource, WithoutAnalysisDeliversTheImages) {
   EXPECT_FALSE(source.next(frame));
 }
 
-TEST(PrefetchingSource, DecodingErrorArrivesAfterTheFramesBeforeIt) {
-  PrefetchingSource source(std::make_unique<CountingSource>(20, 7, nullptr), 2, recordingAnalysis());
+// Frames 0 .. good_frames - 1 arrive in order, then next() throws `message`.
+void expectFramesThenError(PrefetchingSource& source, std::size_t good_frames, const char* message) {
   SourceFrame frame;
-  for (std::size_t k = 0; k < 7; ++k) {
+  for (std::size_t k = 0; k < good_frames; ++k) {
     ASSERT_TRUE(source.next(frame));
     EXPECT_EQ(frame.index, k);
   }
   try {
     source.next(frame);
-    FAIL() << "no error after frame 6";
+    ADD_FAILURE() << "no error after " << good_frames << " frames";
   } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "frame 7 is corrupt");
+    EXPECT_STREQ(e.what(), message);
   }
+}
+
+TEST(PrefetchingSource, DecodingErrorArrivesAfterTheFramesBeforeIt) {
+  PrefetchingSource source(std::make_unique<CountingSource>(20, 7, nullptr), 2, recordingAnalysis());
+  expectFramesThenError(source, 7, "frame 7 is corrupt");
 }
 
 TEST(PrefetchingSource, AnalysisErrorNamesTheFrameAndStopsThere) {
   std::atomic<std::size_t> read{0};
   PrefetchingSource source(std::make_unique<CountingSource>(20, kNever, &read), 2, recordingAnalysis(5.0f));
-  SourceFrame frame;
-  for (std::size_t k = 0; k < 5; ++k) {
-    ASSERT_TRUE(source.next(frame));
-    EXPECT_EQ(frame.index, k);
-  }
-  try {
-    source.next(frame);
-    FAIL() << "no error at frame 5";
-  } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "f5: cannot analyse this image");
-  }
+  expectFramesThenError(source, 5, "f5: cannot analyse this image");
   EXPECT_LT(read.load(), 20u);  // the reader stopped there, not reading the whole source
 }
 
