@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <stdexcept>
+#include <memory>
 #include <string>
 
 #include "frame_source.h"
