@@ -19,7 +19,7 @@ packages=(
   libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev libdeflate-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch python3-rosbag
   rosbash python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs
-  python3-tf2-ros python3-numpy python3-matplotlib
+  python3-tf2-ros python3-diagnostic-msgs python3-numpy python3-matplotlib
 )
 # The test command also builds the sanitizer, fuzzing and ARM checks (scripts/hardening.sh).
 test_packages=(clang-14 libclang-rt-14-dev g++-aarch64-linux-gnu)
