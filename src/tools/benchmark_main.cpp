@@ -305,6 +305,22 @@ void BM_Stage_WarpOlder(benchmark::State& state) {
 }
 BENCHMARK(BM_Stage_WarpOlder)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// The same warp of a source that is not in cache, as in the pipeline (the older frame was last
+// used when it was analysed): each iteration warps the next of 24 copies (24 MB).
+void BM_Stage_WarpUncachedOlder(benchmark::State& state) {
+  std::vector<cv::Mat1f> sources(24);
+  for (cv::Mat1f& source : sources) source = inputs().older.grey.clone();
+  cv::Mat1f warped;
+  std::size_t next = 0;
+  for (auto _ : state) {
+    oefmt::warpSimilarityWindowed(sources[next], 0.05, 1.03, inputs().context->window(), warped,
+                                  0.0f);
+    next = (next + 1) % sources.size();
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(BM_Stage_WarpUncachedOlder)->Unit(benchmark::kMicrosecond);
+
 void BM_Stage_PolarUnwrapBand(benchmark::State& state) {
   cv::Mat1f polar;
   for (auto _ : state) {
