@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// AVX2 + FMA kernel of the line sampler (warp rows, polar and log-polar rays): eight samples
-// per step with hardware gathers. Compiled with -mavx2 -mfma (CMakeLists.txt) and called only
-// on CPUs that have both. Nothing but intrinsics and plain types in here: an inline function
-// from a shared header, compiled with AVX2 in this file, could otherwise be the copy the
-// linker keeps for portable callers.
+// AVX2 + FMA kernel of the line sampler (warp rows, polar and log-polar rays): eight samples per
+// step, their neighbours fetched with 64-bit loads. Compiled with -mavx2 -mfma (CMakeLists.txt)
+// and called only on CPUs that have both. Nothing but intrinsics and plain types in here: an
+// inline function from a shared header, compiled with AVX2 in this file, could otherwise be the
+// copy the linker keeps for portable callers.
 #if defined(__x86_64__)
 #include <immintrin.h>
 
@@ -42,7 +42,7 @@ void sampleLineAvx2(const LineSamples& line) {
     const __m256 fx = _mm256_sub_ps(sx, floor_x), fy = _mm256_sub_ps(sy, floor_y);
     const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(iy, vstride), ix);
     __m256 p00, p01, p10, p11;
-    gatherNeighbours(src, stride, index, p00, p01, p10, p11);
+    loadNeighbours(src, stride, index, p00, p01, p10, p11);
     const __m256 top = _mm256_fmadd_ps(fx, _mm256_sub_ps(p01, p00), p00);
     const __m256 bottom = _mm256_fmadd_ps(fx, _mm256_sub_ps(p11, p10), p10);
     const __m256 value = _mm256_fmadd_ps(fy, _mm256_sub_ps(bottom, top), top);
