@@ -209,6 +209,26 @@ TEST(Warp, FastKernelMatchesThePortableOne) {
   }
 }
 
+// A registration gone wrong can hand the warp a NaN rotation or an absurd zoom: the output is
+// finite (zero where the source is not sampled), with either kernel, and no position is cast
+// to int out of range (the ASan + UBSan build runs this too).
+TEST(Warp, NonFiniteOrExtremeTransformsGiveFiniteOutput) {
+  const int n = 64;
+  const SeparableWindow window(n, 0.1);
+  cv::Mat1f source(n, n);
+  cv::randu(source, 1.0f, 255.0f);
+  for (const SimdKernel kernel : {SimdKernel::kAuto, SimdKernel::kPortable}) {
+    cv::Mat1f out;
+    warpSimilarityWindowed(source, std::numeric_limits<double>::quiet_NaN(), 1.0, window, out,
+                           0.0f, kernel);
+    EXPECT_EQ(cv::countNonZero(out), 0);
+    for (const double zoom : {1e-30, 1e-45, 1e30}) {
+      warpSimilarityWindowed(source, 0.3, zoom, window, out, 0.0f, kernel);
+      EXPECT_TRUE(cv::checkRange(out)) << zoom;
+    }
+  }
+}
+
 TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheCentre) {
   const SeparableWindow flat(64, 0.0);  // no taper: compare raw pixels
   cv::Mat1f image(64, 64, 0.0f), turned;
