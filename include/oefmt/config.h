@@ -24,7 +24,7 @@ struct RegistrationConfig {
   /// identity: the older frame's cached spectrum is correlated without a warp and its FFT
   /// (0 = always warp) [px].
   double identity_warp_px = 0.1;
-  FftPlanning fft_planning = FftPlanning::kMeasure;  ///< FFTW planning effort (once per size)
+  FftPlanning fft_planning = FftPlanning::kPatient;  ///< FFTW planning effort (once per size and machine)
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -89,6 +90,10 @@ class SpectraBuilder {
   std::shared_ptr<const SpectralContext> context_;
   cv::Mat1f magnitude_;
 };
+
+/// What to tell a user before a SpectralContext(config) measures FFT plans that the wisdom does
+/// not hold yet (fftPlansKnown false): which plans, about how long, and where they are kept.
+std::string fftPlanningNotice(const RegistrationConfig& config);
 
 /// Writes rows 0 .. N/2 + 1 of the centred N x N image |spectrum| * filter (DC at (N/2, N/2)):
 /// the half plane the log-polar transform samples (the magnitude is point-symmetric), filling

@@ -142,13 +142,13 @@ std::vector<Section> sections(EstimatorConfig& c) {
                        r.fft_planning = FftPlanning::kEstimate;
                      } else if (v == "measure") {
                        r.fft_planning = FftPlanning::kMeasure;
+                     } else if (v == "patient") {
+                       r.fft_planning = FftPlanning::kPatient;
                      } else {
-                       badValue(k, "estimate or measure");
+                       badValue(k, "estimate, measure or patient");
                      }
                    },
-                   [&r] {
-                     return std::string(r.fft_planning == FftPlanning::kMeasure ? "measure" : "estimate");
-                   }}},
+                   [&r] { return std::string(toString(r.fft_planning)); }}},
                  [&r] { r.validate(); }});
   MatchingConfig& m = c.matching;
   all.push_back({"matching",

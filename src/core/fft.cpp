@@ -61,6 +61,15 @@ bool exportWisdomLocked(const std::string& path) {
 
 }  // namespace
 
+const char* toString(FftPlanning planning) {
+  switch (planning) {
+    case FftPlanning::kEstimate: return "estimate";
+    case FftPlanning::kMeasure: return "measure";
+    case FftPlanning::kPatient: return "patient";
+  }
+  return "unknown";
+}
+
 std::string defaultFftWisdomPath() {
   if (const char* explicit_path = std::getenv("OEFMT_FFTW_WISDOM")) {
     const std::string path(explicit_path);
@@ -82,13 +91,32 @@ std::string defaultFftWisdomPath() {
 
 namespace {
 
+unsigned plannerFlags(FftPlanning planning) {
+  switch (planning) {
+    case FftPlanning::kEstimate: return FFTW_ESTIMATE;
+    case FftPlanning::kMeasure: return FFTW_MEASURE;
+    case FftPlanning::kPatient: return FFTW_PATIENT;
+  }
+  return FFTW_MEASURE;
+}
+
+// The first measured Fft2d (or fftPlansKnown) of a process reads the wisdom file once; later
+// ones find its plans in memory. The caller holds the planner mutex.
+void importWisdomOnceLocked(FftPlanning planning) {
+  static bool imported = false;
+  if (imported || planning == FftPlanning::kEstimate) return;
+  const std::string wisdom = defaultFftWisdomPath();
+  if (wisdom.empty()) return;
+  importWisdomLocked(wisdom);
+  imported = true;
+}
+
 // Plans the r2c and c2r transforms between `real` and `complex` (the same memory: in place) and
 // saves the wisdom when it had to be measured. The caller holds the planner mutex.
 void planPairLocked(int size, float* real, fftwf_complex* complex, FftPlanning planning,
                     fftwf_plan& forward, fftwf_plan& inverse) {
-  const bool measure = planning == FftPlanning::kMeasure;
-  const unsigned flags = measure ? FFTW_MEASURE : FFTW_ESTIMATE;
-  const std::string wisdom = measure ? defaultFftWisdomPath() : std::string();
+  const unsigned flags = plannerFlags(planning);
+  const std::string wisdom = planning == FftPlanning::kEstimate ? std::string() : defaultFftWisdomPath();
   const auto start = std::chrono::steady_clock::now();
   forward = fftwf_plan_dft_r2c_2d(size, size, real, complex, flags);
   inverse = fftwf_plan_dft_c2r_2d(size, size, complex, real, flags);
@@ -111,6 +139,24 @@ bool exportFftWisdom(const std::string& path) {
   return exportWisdomLocked(path);
 }
 
+bool fftPlansKnown(int size, FftPlanning planning) {
+  if (planning == FftPlanning::kEstimate) return true;
+  if (size < 2 || size % 2 != 0) return false;
+  cv::Mat2f spectrum(size, size / 2 + 1);  // aligned like the buffers Fft2d plans on
+  float* real = reinterpret_cast<float*>(spectrum.data);
+  auto* complex = reinterpret_cast<fftwf_complex*>(spectrum.data);
+  std::lock_guard<std::mutex> lock(plannerMutex());
+  importWisdomOnceLocked(planning);
+  const unsigned flags = plannerFlags(planning) | FFTW_WISDOM_ONLY;
+  bool known = true;
+  for (fftwf_plan plan : {fftwf_plan_dft_r2c_2d(size, size, real, complex, flags),
+                          fftwf_plan_dft_c2r_2d(size, size, complex, real, flags)}) {
+    known = known && plan != nullptr;
+    if (plan != nullptr) fftwf_destroy_plan(plan);
+  }
+  return known;
+}
+
 struct Fft2d::Plans {
   fftwf_plan forward_in_place = nullptr;
   fftwf_plan inverse_in_place = nullptr;
@@ -128,12 +174,7 @@ Fft2d::Fft2d(int size, FftPlanning planning) : size_(size), plans_(std::make_uni
   }
   cv::Mat2f spectrum(size, spectrumCols());
   std::lock_guard<std::mutex> lock(plannerMutex());
-  static bool wisdom_imported = false;  // guarded by the planner mutex
-  const std::string wisdom = planning == FftPlanning::kMeasure ? defaultFftWisdomPath() : std::string();
-  if (!wisdom_imported && !wisdom.empty()) {
-    importWisdomLocked(wisdom);
-    wisdom_imported = true;
-  }
+  importWisdomOnceLocked(planning);
   plans_->planning = planning;
   planPairLocked(size, reinterpret_cast<float*>(spectrum.data),
                  reinterpret_cast<fftwf_complex*>(spectrum.data), planning,

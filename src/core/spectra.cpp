@@ -137,6 +137,15 @@ void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::
   }
 }
 
+std::string fftPlanningNotice(const RegistrationConfig& config) {
+  const std::string n = std::to_string(config.size);
+  const std::string wisdom = defaultFftWisdomPath();
+  return "measuring FFTW plans for " + n + "x" + n + " transforms (registration.fft_planning: " +
+         toString(config.fft_planning) + "; at N = 512 about 1 s with measure, 10 s with patient)" +
+         (wisdom.empty() ? std::string(", at every start: OEFMT_FFTW_WISDOM=none keeps no wisdom")
+                         : ", once: they are kept in " + wisdom);
+}
+
 SpectraBuilder::SpectraBuilder(std::shared_ptr<const SpectralContext> context)
     : context_(std::move(context)) {
   if (!context_) throw InputError("SpectraBuilder: null context");

@@ -61,8 +61,12 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
   ROS_INFO_STREAM(name_ << ": effective estimator configuration:\n" << configToYaml(estimator_config_));
   {
     // Plan the FFTs now (FFTW keeps what it measured for later plans of the same size): the
-    // first frame must not stall the stream for the second or two planning takes.
-    const SpectralContext warm_up(estimator_config_.registration);
+    // first frame must not stall the stream for the seconds planning takes.
+    const RegistrationConfig& registration = estimator_config_.registration;
+    if (!fftPlansKnown(registration.size, registration.fft_planning)) {
+      ROS_INFO_STREAM(name_ << ": " << fftPlanningNotice(registration));
+    }
+    const SpectralContext warm_up(registration);
   }
 
   odometry_publisher_ = nh_.advertise<nav_msgs::Odometry>("odom", 20);

@@ -97,6 +97,17 @@ TEST(EstimatorConfig, AcceptsCommonSpellings) {
   EXPECT_FALSE(c.registration.resolve_half_turn);
 }
 
+TEST(EstimatorConfig, EveryFftPlanningEffortRoundTrips) {
+  for (const FftPlanning planning : {FftPlanning::kEstimate, FftPlanning::kMeasure, FftPlanning::kPatient}) {
+    EstimatorConfig config;
+    config.registration.fft_planning = planning;
+    const EstimatorConfig loaded = loadConfig(writeYaml("planning", configToYaml(config)));
+    EXPECT_EQ(loaded.registration.fft_planning, planning) << toString(planning);
+  }
+  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  fft_planning: exhaustive\n").find("estimate, measure or patient"),
+            std::string::npos);
+}
+
 TEST(EstimatorConfig, ErrorsNameTheKey) {
   EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  sise: 512\n").find("registration.sise"),
             std::string::npos);

@@ -38,9 +38,16 @@ class ScopedEnvironment {
   std::optional<std::string> old_;
 };
 
+// Tests that make FFTW forget its wisdom read the file back after, so that the tests after them
+// do not measure their plans again (seconds each at N = 512 with the default patient planning).
+class FftWisdom : public ::testing::Test {
+ protected:
+  void TearDown() override { importFftWisdom(defaultFftWisdomPath()); }
+};
+
 // forward then inverse gives the input times N^2 when the plans are sound.
-void expectRoundTrip(int n) {
-  const Fft2d fft(n, FftPlanning::kMeasure);
+void expectRoundTrip(int n, FftPlanning planning = FftPlanning::kMeasure) {
+  const Fft2d fft(n, planning);
   cv::Mat1f image(n, n), back;
   cv::randu(image, -1.0f, 1.0f);
   cv::Mat2f spectrum;
@@ -49,7 +56,7 @@ void expectRoundTrip(int n) {
   EXPECT_LT(cv::norm(back / static_cast<float>(n * n), image, cv::NORM_INF), 1e-5);
 }
 
-TEST(FftWisdom, ExportedWisdomImportsAgain) {
+TEST_F(FftWisdom, ExportedWisdomImportsAgain) {
   test::TempDir dir;
   const std::string file = dir / "cache/wisdom";
   expectRoundTrip(48);
@@ -62,7 +69,7 @@ TEST(FftWisdom, ExportedWisdomImportsAgain) {
   expectRoundTrip(48);
 }
 
-TEST(FftWisdom, DamagedOrMissingFileIsRefusedAndPlanningStillWorks) {
+TEST_F(FftWisdom, DamagedOrMissingFileIsRefusedAndPlanningStillWorks) {
   test::TempDir dir;
   const std::string file = dir / "wisdom";
   std::ofstream(file) << "(fftw-3.3.10 fftwf_wisdom #x0 #x1\n  (\"garbage\" 1 2 3 ((((\n";
@@ -73,7 +80,31 @@ TEST(FftWisdom, DamagedOrMissingFileIsRefusedAndPlanningStillWorks) {
   EXPECT_FALSE(exportFftWisdom(""));
 }
 
-TEST(FftWisdom, DefaultPathFollowsTheEnvironment) {
+// Forgets every plan FFTW knows: a damaged wisdom file is refused as a whole.
+void forgetAllWisdom() {
+  test::TempDir dir;
+  const std::string file = dir / "damaged";
+  std::ofstream(file) << "(fftw-3.3.10 fftwf_wisdom #x0 #x1\n  (\"garbage\" ((((\n";
+  ASSERT_FALSE(importFftWisdom(file));
+}
+
+TEST_F(FftWisdom, KnowsWhenPlansStillNeedMeasuring) {
+  constexpr int kN = 58;  // a size no other test plans
+  fftPlansKnown(kN, FftPlanning::kMeasure);  // the wisdom file is read now, not after forgetting
+  forgetAllWisdom();
+  EXPECT_TRUE(fftPlansKnown(kN, FftPlanning::kEstimate)) << "estimating measures nothing";
+  EXPECT_FALSE(fftPlansKnown(kN, FftPlanning::kMeasure));
+  EXPECT_FALSE(fftPlansKnown(kN, FftPlanning::kPatient));
+  expectRoundTrip(kN, FftPlanning::kMeasure);
+  EXPECT_TRUE(fftPlansKnown(kN, FftPlanning::kMeasure));
+  EXPECT_FALSE(fftPlansKnown(kN, FftPlanning::kPatient)) << "measured plans are not patient ones";
+  expectRoundTrip(kN, FftPlanning::kPatient);
+  EXPECT_TRUE(fftPlansKnown(kN, FftPlanning::kPatient));
+  EXPECT_FALSE(fftPlansKnown(kN + 2, FftPlanning::kPatient)) << "wisdom is per size";
+  EXPECT_FALSE(fftPlansKnown(57, FftPlanning::kMeasure)) << "odd sizes are refused";
+}
+
+TEST_F(FftWisdom, DefaultPathFollowsTheEnvironment) {
   {
     ScopedEnvironment custom("OEFMT_FFTW_WISDOM", "/some/where/wisdom");
     EXPECT_EQ(defaultFftWisdomPath(), "/some/where/wisdom");
