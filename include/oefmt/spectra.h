@@ -92,7 +92,8 @@ class SpectraBuilder {
 };
 
 /// What to tell a user before a SpectralContext(config) measures FFT plans that the wisdom does
-/// not hold yet (fftPlansKnown false): which plans, about how long, and where they are kept.
+/// not hold yet: which plans, about how long, and where they are kept. Empty when the wisdom
+/// holds them (fftPlansKnown), i.e. when making the context is quick.
 std::string fftPlanningNotice(const RegistrationConfig& config);
 
 /// Writes rows 0 .. N/2 + 1 of the centred N x N image |spectrum| * filter (DC at (N/2, N/2)):

@@ -138,15 +138,14 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   {"fft_planning",
                    [&r](const YamlNode& n, const std::string& k) {
                      const std::string v = readString(n, k);
-                     if (v == "estimate") {
-                       r.fft_planning = FftPlanning::kEstimate;
-                     } else if (v == "measure") {
-                       r.fft_planning = FftPlanning::kMeasure;
-                     } else if (v == "patient") {
-                       r.fft_planning = FftPlanning::kPatient;
-                     } else {
-                       badValue(k, "estimate, measure or patient");
+                     for (const FftPlanning planning :
+                          {FftPlanning::kEstimate, FftPlanning::kMeasure, FftPlanning::kPatient}) {
+                       if (v == toString(planning)) {
+                         r.fft_planning = planning;
+                         return;
+                       }
                      }
+                     badValue(k, "estimate, measure or patient");
                    },
                    [&r] { return std::string(toString(r.fft_planning)); }}},
                  [&r] { r.validate(); }});

@@ -138,6 +138,7 @@ void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::
 }
 
 std::string fftPlanningNotice(const RegistrationConfig& config) {
+  if (fftPlansKnown(config.size, config.fft_planning)) return std::string();
   const std::string n = std::to_string(config.size);
   const std::string wisdom = defaultFftWisdomPath();
   return "measuring FFTW plans for " + n + "x" + n + " transforms (registration.fft_planning: " +

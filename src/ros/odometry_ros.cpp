@@ -63,9 +63,8 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
     // Plan the FFTs now (FFTW keeps what it measured for later plans of the same size): the
     // first frame must not stall the stream for the seconds planning takes.
     const RegistrationConfig& registration = estimator_config_.registration;
-    if (!fftPlansKnown(registration.size, registration.fft_planning)) {
-      ROS_INFO_STREAM(name_ << ": " << fftPlanningNotice(registration));
-    }
+    const std::string notice = fftPlanningNotice(registration);
+    if (!notice.empty()) ROS_INFO_STREAM(name_ << ": " << notice);
     const SpectralContext warm_up(registration);
   }
 

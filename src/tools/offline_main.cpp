@@ -161,8 +161,9 @@ int main(int argc, char** argv) {
     // vs 2.19 s with one; a second reader thread gained nothing more and cost 13 MB); each
     // frame queued costs the 3 MB of its spectra.
     config.validate();
-    if (!options.quiet && !oefmt::fftPlansKnown(config.registration.size, config.registration.fft_planning)) {
-      std::fprintf(stderr, "oefmt_offline: %s\n", oefmt::fftPlanningNotice(config.registration).c_str());
+    if (!options.quiet) {
+      const std::string notice = oefmt::fftPlanningNotice(config.registration);
+      if (!notice.empty()) std::fprintf(stderr, "oefmt_offline: %s\n", notice.c_str());
     }
     const auto context = std::make_shared<const oefmt::SpectralContext>(config.registration);
     oefmt::PrefetchingSource source(
