@@ -3,6 +3,7 @@
 // trajectory error, drift per distance travelled and loop error.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <utility>
@@ -76,6 +77,18 @@ struct EvaluationOptions {
   bool with_scale = true;          ///< similarity (true) or rigid (false) alignment
   /// Segment lengths for the drift, as fractions of the ground truth's path length.
   std::vector<double> drift_segment_fractions = {0.1, 0.2, 0.3, 0.4, 0.5};
+  /// A heading step (yaw change between consecutive matched poses) whose error exceeds this
+  /// counts as off [rad].
+  double heading_step_threshold = 2.0 * M_PI / 180.0;
+};
+
+/// Errors of the yaw change between consecutive matched poses: the estimate's change minus the
+/// truth's, wrapped to (-pi, pi]. Independent of the alignment.
+struct HeadingStepErrors {
+  std::size_t count = 0;       ///< steps measured
+  double rmse = 0.0;           ///< [rad]
+  double max = 0.0;            ///< largest |error| [rad]
+  std::size_t over_threshold = 0;  ///< steps with |error| > heading_step_threshold
 };
 
 /// Relative error over segments of one length.
@@ -99,6 +112,7 @@ struct EvaluationResult {
   /// gap the estimate leaves where the truth closes.
   double loop_error = 0.0;
   double loop_error_percent = 0.0;     ///< loop_error / path_length * 100
+  HeadingStepErrors heading_steps;
   Trajectory aligned_estimate;         ///< matched estimate poses after alignment
   Trajectory matched_truth;            ///< their ground-truth poses
 };

@@ -57,6 +57,30 @@ std::vector<DriftSegment> measureDrift(const std::vector<Eigen::Vector3d>& estim
   return segments;
 }
 
+// Yaw about z of an orientation (body to world) [rad].
+double yawOf(const Eigen::Quaterniond& q) {
+  return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()), 1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
+}
+
+double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+HeadingStepErrors measureHeadingSteps(const Trajectory& estimate, const Trajectory& truth,
+                                      double threshold) {
+  HeadingStepErrors steps;
+  double squares = 0.0;
+  for (std::size_t k = 1; k < estimate.size(); ++k) {
+    const double estimated = yawOf(estimate[k].orientation) - yawOf(estimate[k - 1].orientation);
+    const double true_change = yawOf(truth[k].orientation) - yawOf(truth[k - 1].orientation);
+    const double error = std::fabs(wrapAngle(estimated - true_change));
+    ++steps.count;
+    squares += error * error;
+    steps.max = std::max(steps.max, error);
+    if (error > threshold) ++steps.over_threshold;
+  }
+  if (steps.count > 0) steps.rmse = std::sqrt(squares / steps.count);
+  return steps;
+}
+
 }  // namespace
 
 Trajectory readTum(const std::string& path) {
@@ -236,6 +260,8 @@ EvaluationResult evaluateTrajectory(const Trajectory& estimate, const Trajectory
   result.loop_error = ((aligned.back() - aligned.front()) - (reference.back() - reference.front())).norm();
   result.loop_error_percent =
       result.path_length > 0.0 ? result.loop_error / result.path_length * 100.0 : std::nan("");
+  result.heading_steps = measureHeadingSteps(result.aligned_estimate, result.matched_truth,
+                                             options.heading_step_threshold);
   return result;
 }
 
@@ -258,7 +284,12 @@ std::string evaluationJson(const EvaluationResult& r, const EvaluationOptions& o
          << "}";
   }
   json << "],\"loop_error\":" << jsonNumber(r.loop_error)
-       << ",\"loop_error_percent\":" << jsonNumber(r.loop_error_percent) << "}";
+       << ",\"loop_error_percent\":" << jsonNumber(r.loop_error_percent)
+       << ",\"heading_steps\":{\"count\":" << r.heading_steps.count
+       << ",\"rmse_deg\":" << jsonNumber(r.heading_steps.rmse * 180.0 / M_PI)
+       << ",\"max_deg\":" << jsonNumber(r.heading_steps.max * 180.0 / M_PI)
+       << ",\"threshold_deg\":" << jsonNumber(options.heading_step_threshold * 180.0 / M_PI)
+       << ",\"over_threshold\":" << r.heading_steps.over_threshold << "}}";
   return json.str();
 }
 
@@ -286,6 +317,11 @@ std::string evaluationTable(const EvaluationResult& r, const EvaluationOptions& 
   row("drift (all segments)", std::isfinite(r.drift_percent) ? format("%.3f %%", r.drift_percent) : "n/a");
   row("loop error", format("%.4f m", r.loop_error) + " (" + format("%.3f %%", r.loop_error_percent) +
                         " of the path)");
+  row("heading steps", std::to_string(r.heading_steps.count) + ", error rmse " +
+                           format("%.3f deg", r.heading_steps.rmse * 180.0 / M_PI) + ", max " +
+                           format("%.3f deg", r.heading_steps.max * 180.0 / M_PI) + ", " +
+                           std::to_string(r.heading_steps.over_threshold) + " over " +
+                           format("%g deg", options.heading_step_threshold * 180.0 / M_PI));
   return out.str();
 }
 

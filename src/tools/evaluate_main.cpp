@@ -27,7 +27,8 @@ const char* const kUsage = R"(usage: oefmt_evaluate [options] ESTIMATE.tum GROUN
 Aligns the estimate to the ground truth by least squares (Umeyama; similarity in x-y by default)
 and prints the absolute trajectory error (rmse, mean, median, max), the drift (relative position
 error per distance travelled, over segments of 10..50 % of the path), the loop error (gap between
-the estimate's and the truth's first-to-last displacement) as a table, then one line of JSON.
+the estimate's and the truth's first-to-last displacement) and the errors of the heading steps
+(yaw change between consecutive poses) as a table, then one line of JSON.
 TUM files: 't x y z qx qy qz qw' per line, '#' comments.
 
 options:
@@ -36,6 +37,7 @@ options:
   --3d                 align and measure in 3-D (default: x-y only)
   --no-scale           rigid alignment (default: with scale, for monocular estimates)
   --segments F,F,...   drift segment lengths as fractions of the path (default 0.1,0.2,0.3,0.4,0.5)
+  --heading-threshold DEG  heading steps off by more than this are counted (default 2)
   --plot FILE.png      draw both trajectories (top view) and the error over time
   --title TEXT         plot title
   --aligned FILE.tum   write the aligned, matched estimate
@@ -120,6 +122,10 @@ int main(int argc, char** argv) {
         options.with_scale = false;
       } else if (arg == "--segments") {
         options.drift_segment_fractions = fractionList(value());
+      } else if (arg == "--heading-threshold") {
+        const double degrees = args.number(arg);
+        if (!(degrees > 0.0 && degrees < 180.0)) throw oefmt::InputError("--heading-threshold must be in (0, 180) degrees");
+        options.heading_step_threshold = degrees * M_PI / 180.0;
       } else if (arg == "--plot") {
         plot = value();
       } else if (arg == "--title") {

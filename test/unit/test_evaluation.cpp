@@ -173,6 +173,31 @@ TEST(Evaluation, TumFilesRoundTripAndReportBadLines) {
   EXPECT_THROW(readTum(dir / "missing.tum"), DatasetError);
 }
 
+TEST(Evaluation, HeadingStepErrorsCountTheStepsOffByMoreThanTheThreshold) {
+  const Trajectory truth = groundTruth(50);
+  // A constant yaw offset (any alignment) changes no step; turns added at two frames do.
+  Trajectory estimate = transformed(truth, 1.0, Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                                    Eigen::Vector3d::Zero());
+  const auto turn = [&](std::size_t from, double radians) {
+    for (std::size_t k = from; k < estimate.size(); ++k) {
+      estimate[k].orientation = Eigen::Quaterniond(Eigen::AngleAxisd(radians, Eigen::Vector3d::UnitZ())) *
+                                estimate[k].orientation;
+    }
+  };
+  EvaluationOptions options;
+  EXPECT_EQ(evaluateTrajectory(estimate, truth, options).heading_steps.over_threshold, 0u);
+  EXPECT_LT(evaluateTrajectory(estimate, truth, options).heading_steps.max, 1e-9);
+  turn(10, 3.0 * M_PI / 180.0);   // one step 3 degrees off
+  turn(30, -1.0 * M_PI / 180.0);  // one step 1 degree off: below the threshold
+  turn(40, 179.0 * M_PI / 180.0); // wraps: 179 degrees off
+  const EvaluationResult result = evaluateTrajectory(estimate, truth, options);
+  EXPECT_EQ(result.heading_steps.count, 49u);
+  EXPECT_EQ(result.heading_steps.over_threshold, 2u);
+  EXPECT_NEAR(result.heading_steps.max * 180.0 / M_PI, 179.0, 1e-6);
+  options.heading_step_threshold = 0.5 * M_PI / 180.0;
+  EXPECT_EQ(evaluateTrajectory(estimate, truth, options).heading_steps.over_threshold, 3u);
+}
+
 TEST(Evaluation, JsonLineHasEveryFigure) {
   const Trajectory truth = groundTruth(30);
   EvaluationOptions options;
@@ -182,7 +207,8 @@ TEST(Evaluation, JsonLineHasEveryFigure) {
   EXPECT_EQ(json.back(), '}');
   EXPECT_EQ(json.find('\n'), std::string::npos);
   for (const char* key : {"\"matched\":30", "\"alignment\":\"sim2\"", "\"ate\":{\"rmse\":", "\"median\":",
-                          "\"drift_percent\":", "\"loop_error\":", "\"path_length\":"}) {
+                          "\"drift_percent\":", "\"loop_error\":", "\"path_length\":",
+                          "\"heading_steps\":{\"count\":29", "\"over_threshold\":0"}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
   }
   EXPECT_NE(evaluationTable(result, options).find("ATE rmse"), std::string::npos);
