@@ -34,6 +34,9 @@ struct Estimate {
   std::size_t frame_index = 0;  ///< 0-based count of frames pushed since construction/reset
   double stamp = 0.0;
   Pose4 pose;                   ///< see Pose4 for frame, units and covariance
+  /// The part of pose.covariance this frame added: the uncertainty of its step alone (world
+  /// frame, output units; over x, y, z, yaw).
+  cv::Matx44d step_covariance = cv::Matx44d::zeros();
   TrackingState state = TrackingState::kStarted;
   EstimatorMode mode = EstimatorMode::kOefmt;
   /// The pose did not come from a confident registration of this frame (state is not kTracking,

@@ -62,6 +62,12 @@ enum class PeakShape {
 SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* stats = nullptr,
                      PeakShape shape = PeakShape::kDirichlet, SimdKernel kernel = SimdKernel::kAuto);
 
+/// The largest value within +-half_rows x +-half_cols of `centre` (x = column, y = row; rows
+/// wrap, columns wrap if cyclic_cols, else are clipped), refined as findPeak does. For a search
+/// where the motion so far says the peak must be.
+SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
+                             int half_cols, bool cyclic_cols, PeakShape shape = PeakShape::kDirichlet);
+
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at
 /// N = 512, hundreds for a clean registration.

@@ -43,13 +43,31 @@ struct PairRegistration {
   double rotation_zoom_peak = 0.0;  ///< height of the rotation/zoom correlation peak (0..1)
   double translation_peak = 0.0;    ///< height of the translation correlation peak (0..1)
   double confidence = 0.0;          ///< 0 (unusable) .. 1, from both peak-to-sidelobe ratios
-  int rotation_zoom_candidate = 0;  ///< which rotation/zoom peak registered (0 = the highest)
+  /// Which rotation/zoom peak registered: 0 the first tried (the prior's window, if any, else the
+  /// highest), 1.. the next highest; kPredicted: none, the prior's rotation and zoom were used.
+  int rotation_zoom_candidate = 0;
+  static constexpr int kPredicted = -1;
   bool half_turn = false;           ///< the 180-degree alternative won
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
   bool warped = true;
 
   bool usable() const { return status == RegistrationStatus::kOk; }
+};
+
+/// What the motion so far predicts for a pair's rotation and zoom. The rotation/zoom surface's
+/// highest value within the window is tried first, then the surface's highest peaks, and last
+/// the predicted rotation and zoom themselves: low overlap, weak texture and repetitive patterns
+/// weaken the true rotation/zoom peak long before the translation peak, and another peak can be
+/// the highest. A registration on the predicted values (rotation_zoom_candidate kPredicted)
+/// measured only the translation; its rotation and zoom carry the prediction's sigmas.
+struct RegistrationPrior {
+  double rotation = 0.0;         ///< predicted theta [rad]
+  double log_zoom = 0.0;         ///< predicted ln s
+  double rotation_sigma = 0.0;   ///< 1-sigma of the prediction [rad]
+  double log_zoom_sigma = 0.0;   ///< 1-sigma of the prediction [ln s]
+  double rotation_window = 0.0;  ///< half width of the window [rad]
+  double log_zoom_window = 0.0;  ///< half width of the window [ln s]
 };
 
 /// Correlation surfaces of the last registration, for diagnostics and plots.
@@ -76,7 +94,8 @@ class Registrar {
   /// Registers older -> newer. Throws InputError if a frame is empty or the sizes differ.
   PairRegistration registerPair(const FrameSpectra& older, const FrameSpectra& newer,
                                 RegistrationMethod method = RegistrationMethod::kEnergyVectors,
-                                RegistrationSurfaces* surfaces = nullptr);
+                                RegistrationSurfaces* surfaces = nullptr,
+                                const RegistrationPrior* prior = nullptr);
 
   const SpectralContext& context() const { return *context_; }
   std::shared_ptr<const SpectralContext> sharedContext() const { return context_; }
@@ -92,13 +111,20 @@ class Registrar {
   // The rotation/zoom correlation surface of the pair, into rotation_zoom_surface_.
   void correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer);
   // Rotation, zoom, translation and confidence with the highest peak left on the rotation/zoom
-  // surface; `peak` receives it.
+  // surface, or within the prior's window; `peak` receives it.
   void registerOnce(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
-                    PairRegistration& result, cv::Point& peak, RegistrationSurfaces* surfaces);
+                    PairRegistration& result, cv::Point& peak, RegistrationSurfaces* surfaces,
+                    const RegistrationPrior* window);
   // Each returns the peak-to-sidelobe ratio of its correlation surface.
-  double registerRotationZoom(RegistrationMethod method, PairRegistration& result, cv::Point& peak);
+  double registerRotationZoom(RegistrationMethod method, PairRegistration& result, cv::Point& peak,
+                              const RegistrationPrior* window);
+  // The translation alone, with the prior's rotation and zoom.
+  void registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
+                       const RegistrationPrior& prior, PairRegistration& result,
+                       RegistrationSurfaces* surfaces);
   double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
-                             RegistrationMethod method, PairRegistration& result);
+                             RegistrationMethod method, PairRegistration& result,
+                             bool test_half_turn);
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;

@@ -65,6 +65,9 @@ class PoseIntegrator {
   const Pose4& hold(double stamp, const cv::Matx44d& extra_covariance);
   /// Goes back to an earlier pose (e.g. undoing predictions once the real motion is known).
   void restore(const Pose4& pose) { pose_ = pose; }
+  /// The covariance the last integrate() or hold() added to the pose (x, y, z, yaw): the
+  /// uncertainty of that one step alone, in the world frame and output units.
+  const cv::Matx44d& lastStepCovariance() const { return last_step_covariance_; }
 
   const Pose4& pose() const { return pose_; }
   /// Z_k: current altitude above the reference plane (output units).
@@ -76,6 +79,7 @@ class PoseIntegrator {
   double initial_altitude_;
   double fx_;
   Pose4 pose_;
+  cv::Matx44d last_step_covariance_ = cv::Matx44d::zeros();
 };
 
 }  // namespace oefmt

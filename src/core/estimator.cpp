@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/estimator.h"
 
+#include <algorithm>
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <exception>
 #include <future>
@@ -33,6 +35,27 @@ constexpr double kHeldYawSigma = 0.1;
 // Extra sigmas of a predicted step's rotation [rad] and log-zoom.
 constexpr double kPredictedRotationSigma = 0.05;
 constexpr double kPredictedLogZoomSigma = 0.05;
+
+// Half width of the window where a pair's rotation/zoom peak is searched first [surface bins;
+// at N = 512 one rotation bin is 0.35 deg, one zoom bin 1.1 %], plus three sigmas of the
+// prediction. A yaw or climb rate that changes by more within one frame interval is still found
+// by the search of the whole surface that follows.
+constexpr double kPriorWindowBins = 6.0;
+// Steps whose median predicts the next rotation and zoom: a yaw or climb rate that changes
+// shows in the median after two steps, a single wrong step not at all.
+constexpr std::size_t kPredictionSteps = 3;
+
+// Pair 0-2 is not registered when even its slowest depth layer is predicted to move more than
+// this fraction of N along an axis: the circular correlation folds shifts beyond N/2 to the
+// other side, and near it a peak cannot be told from its fold (pair 0-2 of a flight at 60 %
+// overlap moves 0.7 N).
+constexpr double kMaxPairShiftFraction = 0.45;
+
+// Whether a pair's rotation and zoom lie within the prediction's window (true without one).
+bool withinWindow(const PairMotion& motion, const std::optional<RegistrationPrior>& prior) {
+  return !prior || (std::fabs(wrapToPi(motion.rotation - prior->rotation)) <= prior->rotation_window &&
+                    std::fabs(motion.log_zoom - prior->log_zoom) <= prior->log_zoom_window);
+}
 
 struct WindowFrame {
   FrameSpectra spectra;
@@ -74,6 +97,7 @@ struct Estimator::State {
     failed = 0;
     anchor.reset();
     last_step.reset();
+    recent_steps.clear();
     started = false;
     last_stamp = -std::numeric_limits<double>::infinity();
   }
@@ -91,16 +115,24 @@ struct Estimator::State {
   PairMotion efmtStep(const WindowFrame& frame, Estimate& est,
                       std::vector<float>& next_translation01);
   // Three-frame step of the oefmt mode: pair 0-2, pattern matching, optimizer.
-  PairMotion oefmtStep(const WindowFrame& frame, Estimate& est);
+  PairMotion oefmtStep(const WindowFrame& frame, Estimate& est, bool with02);
   // Integrates the step and slides the window.
   void advance(WindowFrame&& frame, const PairMotion& step, std::vector<float>&& next_translation01,
                Estimate& est);
   cv::Matx44d heldGrowth() const;
+  // Whether pair 0-2 of a window whose newest frame is `intervals12` after frame 1 can be
+  // registered: pair 0-1's motion continued must stay within kMaxPairShiftFraction of N.
+  bool pair02InReach(int intervals12) const;
+  // The rotation/zoom that the last motion predicts over `intervals` frame intervals, starting
+  // from `start` (pair 0-1 for pair 0-2); none without a motion or outside oefmt mode.
+  std::optional<RegistrationPrior> predictedRotationZoom(int intervals, const PairMotion* start) const;
 
   const EstimatorConfig& config;
   Registrar registrar;
   Registrar registrar02;  // pair 0-2, on its own thread: its own scratch, the shared tables
   std::future<PairRegistration> pending02;  // pair 0-2 started alongside pair 1-2
+  std::optional<RegistrationPrior> prior02;  // its predicted rotation/zoom (read by the worker)
+  std::optional<RegistrationPrior> prior12;  // pair 1-2's
   LocalOptimizer optimizer;
   PoseIntegrator integrator;
   MultiZoomTranslator multi_zoom;
@@ -118,6 +150,9 @@ struct Estimator::State {
   int failed = 0;                       // consecutive frames that could not be registered
   std::optional<Pose4> anchor;          // the pose at frame 1 while later frames fail
   std::optional<PairMotion> last_step;  // the last motion per frame interval
+  // The last accepted motions per frame interval, newest last (kept through restarts: the
+  // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
+  std::deque<PairMotion> recent_steps;
   bool started = false;
   double last_stamp = -std::numeric_limits<double>::infinity();
 
@@ -145,6 +180,51 @@ class PendingPairGuard {
   std::future<PairRegistration>& pending_;
   int exceptions_;
 };
+
+std::optional<RegistrationPrior> Estimator::State::predictedRotationZoom(int intervals,
+                                                                        const PairMotion* start) const {
+  if (config.mode != EstimatorMode::kOefmt || recent_steps.empty()) return std::nullopt;
+  const int n = config.registration.size;
+  // The median of the last steps' rates: one wrong step does not move the prediction.
+  const auto median = [&](auto field) {
+    std::vector<double> values;
+    for (const PairMotion& m : recent_steps) values.push_back(field(m));
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    return values[values.size() / 2];
+  };
+  RegistrationPrior prior;
+  prior.rotation = median([](const PairMotion& m) { return m.rotation; }) * intervals;
+  prior.log_zoom = median([](const PairMotion& m) { return m.log_zoom; }) * intervals;
+  double rotation_sigma = median([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
+  double log_zoom_sigma = median([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
+  if (start != nullptr) {
+    prior.rotation += start->rotation;
+    prior.log_zoom += start->log_zoom;
+    rotation_sigma = std::hypot(rotation_sigma, start->rotation_sigma);
+    log_zoom_sigma = std::hypot(log_zoom_sigma, start->log_zoom_sigma);
+  }
+  prior.rotation_window = kPriorWindowBins * CV_PI / n + 3.0 * rotation_sigma;
+  prior.log_zoom_window = kPriorWindowBins * registrar.logZoomPerBin() + 3.0 * log_zoom_sigma;
+  // A registration on the prediction itself measured neither: the prediction's own sigma plus a
+  // frame interval's change of the rates (a third of the window).
+  prior.rotation_sigma = std::hypot(rotation_sigma, kPriorWindowBins * CV_PI / n / 3.0);
+  prior.log_zoom_sigma = std::hypot(log_zoom_sigma, kPriorWindowBins * registrar.logZoomPerBin() / 3.0);
+  return prior;
+}
+
+bool Estimator::State::pair02InReach(int intervals12) const {
+  const double length01 = motion01.shift();
+  if (!(length01 > 0.0)) return true;
+  // The slowest layer pair 0-1 saw (the farthest plane) moves the least.
+  double slowest = length01;
+  for (const EnergyPeak& peak : energyPeaks(translation01, config.tracking.layer_min_fraction)) {
+    slowest = std::min(slowest, peak.bin * registrar.shiftPerBin());
+  }
+  const cv::Point2d predicted =
+      motion01.translation * (slowest / length01 * double(gap01 + intervals12) / gap01);
+  const double limit = kMaxPairShiftFraction * config.registration.size;
+  return std::fabs(predicted.x) <= limit && std::fabs(predicted.y) <= limit;
+}
 
 cv::Matx44d Estimator::State::heldGrowth() const {
   const double altitude = integrator.altitude();
@@ -232,15 +312,21 @@ PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
   return step;
 }
 
-PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) {
+PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, bool with02) {
   Clock::time_point t = Clock::now();
-  est.registration02 = pending02.valid() ? pending02.get()
-                                          : registrar02.registerPair(f0->spectra, frame.spectra);
-  est.has_registration02 = true;
+  if (with02) {
+    if (!pending02.valid()) prior02 = predictedRotationZoom(est.frame_gap, &motion01);
+    est.registration02 = pending02.valid()
+                             ? pending02.get()
+                             : registrar02.registerPair(f0->spectra, frame.spectra,
+                                                        RegistrationMethod::kEnergyVectors, nullptr,
+                                                        prior02 ? &*prior02 : nullptr);
+    est.has_registration02 = true;
+  }
   est.registration_ms += msSince(t);
   const PairRegistration& reg12 = est.registration12;
   const PairRegistration& reg02 = est.registration02;
-  const bool usable02 = reg02.usable();
+  const bool usable02 = with02 && reg02.usable();
   const double shift_per_bin = registrar.shiftPerBin();
   const double log_zoom_per_bin = registrar.logZoomPerBin();
   const int gap12 = est.frame_gap;
@@ -269,6 +355,14 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) 
   if (!zoom01.empty()) {
     est.pms12 = matchShift(zoom01, reg12.zoom_energy, detail::shiftOptions(mc));
     if (usable02) est.pms02 = matchShift(zoom01, reg02.zoom_energy, detail::shiftOptions(mc));
+    // A shift puts the pair's zoom at S01's plus the shift; outside the window the motion so
+    // far predicts for the pair, it matched another feature of the vectors.
+    const auto implausible = [&](const MatchResult& pms, const std::optional<RegistrationPrior>& prior) {
+      const double log_zoom = raw_log_zoom01 - pms.value * log_zoom_per_bin;
+      return prior && std::fabs(log_zoom - prior->log_zoom) > prior->log_zoom_window;
+    };
+    if (est.pms12.valid && implausible(est.pms12, prior12)) est.pms12.valid = false;
+    if (est.pms02.valid && implausible(est.pms02, prior02)) est.pms02.valid = false;
   }
   est.matching_ms = msSince(t);
 
@@ -291,6 +385,12 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est) 
   t = Clock::now();
   est.loop = optimizer.solve(motion01, obs12, obs02, initial12, initial02);
   est.optimizer_ms = msSince(t);
+  if (est.loop.status == OptimizerStatus::kConverged && !withinWindow(est.loop.pair12, prior12)) {
+    // The loop bought its closure with a rotation or zoom the motion so far rules out (an outlier
+    // elsewhere in the loop pulled a loosely measured value): the measurement stands.
+    est.loop.status = OptimizerStatus::kFallback;
+    est.loop.message = "rotation or zoom outside the predicted window";
+  }
   if (est.loop.status != OptimizerStatus::kConverged) {
     est.degraded = true;
     return initial12;
@@ -311,6 +411,8 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
 
   // Slide the window: the integrated 1-2 becomes the next 0-1.
   last_step = detail::perInterval(step, est.frame_gap);
+  recent_steps.push_back(*last_step);
+  if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
   motion01 = step;
   translation01 = std::move(next_translation01);
   zoom01 = est.registration12.zoom_energy;
@@ -402,20 +504,26 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                                           ? RegistrationMethod::kClassic
                                           : RegistrationMethod::kEnergyVectors;
     const Clock::time_point t = Clock::now();
-    if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 && config_.parallel_registrations) {
+    const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
+                        s.pair02InReach(static_cast<int>(frame.index - s.f1->index));
+    if (with02 && config_.parallel_registrations) {
       // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
       // cached spectra; each Registrar has its own scratch). Collected in oefmtStep; discarded
       // if pair 1-2 fails.
       const FrameSpectra& older = s.f0->spectra;
       const FrameSpectra& newer = frame.spectra;
+      s.prior02 = s.predictedRotationZoom(static_cast<int>(frame.index - s.f1->index), &s.motion01);
       s.pending02 = s.worker02.submit([&s, &older, &newer] {
-        return s.registrar02.registerPair(older, newer);
+        return s.registrar02.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr,
+                                          s.prior02 ? &*s.prior02 : nullptr);
       });
     }
     const PendingPairGuard pending_guard(s.pending02);
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
-    est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces);
+    s.prior12 = s.predictedRotationZoom(est.frame_gap, nullptr);
+    est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
+                                                  s.prior12 ? &*s.prior12 : nullptr);
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {
       if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below
@@ -428,12 +536,13 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       if (config_.mode == EstimatorMode::kEfmt) {
         step = s.efmtStep(frame, est, next_translation01);
       } else if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01) {
-        step = s.oefmtStep(frame, est);
+        step = s.oefmtStep(frame, est, with02);
       }
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }
   }
   est.pose = s.integrator.pose();
+  if (est.state != TrackingState::kStarted) est.step_covariance = s.integrator.lastStepCovariance();
   est.total_ms = prepare_ms + msSince(start);
   est.estimator_ms = std::max(0.0, est.total_ms - est.registration_ms);
   return std::optional<Estimate>(std::move(est));

@@ -30,8 +30,13 @@ PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
   m.rotation = wrapToPi(finiteOr(r.rotation, 0.0));
   m.log_zoom = r.zoom > 0.0 && std::isfinite(r.zoom) ? std::log(r.zoom) : 0.0;
   m.translation = {finiteOr(r.translation.x, 0.0), finiteOr(r.translation.y, 0.0)};
-  m.rotation_sigma = std::max(finiteOr(r.rotation_sigma, CV_PI) * u.rotation_scale, kMinRotationSigma);
-  m.log_zoom_sigma = std::max(finiteOr(r.log_zoom_sigma, 1.0) * u.log_zoom_scale, kMinLogZoomSigma);
+  // Peak widths become error sigmas; a rotation and zoom taken from the prediction already
+  // carry the prediction's error sigmas.
+  const bool predicted = r.rotation_zoom_candidate == PairRegistration::kPredicted;
+  m.rotation_sigma = std::max(finiteOr(r.rotation_sigma, CV_PI) * (predicted ? 1.0 : u.rotation_scale),
+                              kMinRotationSigma);
+  m.log_zoom_sigma = std::max(finiteOr(r.log_zoom_sigma, 1.0) * (predicted ? 1.0 : u.log_zoom_scale),
+                              kMinLogZoomSigma);
   const double shift = m.shift();
   const double along = std::max(finiteOr(r.shift_sigma, 1e3) * u.shift_scale, kMinShiftSigma);
   // Below a pixel the direction means little: the along-track sigma holds in every direction.

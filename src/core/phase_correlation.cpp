@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "oefmt/error.h"
 #include "simd_kernels.h"
@@ -69,6 +70,31 @@ double widenedPeakOffset(float left, float centre, float right) {
   const double asymmetry = l + r > 0.0 ? (r - l) / (r + l) : 1.0;
   const double weight = asymmetry * asymmetry;
   return weight * sincRatioOffset(left, centre, right) + (1.0 - weight) * centre_of_mass;
+}
+
+// The peak at `at` (of -surface when `negative`) refined on each axis by `shape`.
+SurfacePeak refinedPeak(const cv::Mat1f& surface, cv::Point at, bool negative, bool cyclic_cols,
+                        PeakShape shape) {
+  SurfacePeak peak;
+  peak.row = at.y;
+  peak.col = at.x;
+  const float sign = negative ? -1.0f : 1.0f;
+  peak.value = sign * surface(at.y, at.x);
+  auto sample = [&](int r, int c) -> float {
+    r = wrap(r, surface.rows);
+    if (cyclic_cols) {
+      c = wrap(c, surface.cols);
+    } else if (c < 0 || c >= surface.cols) {
+      return 0.0f;
+    }
+    return sign * surface(r, c);
+  };
+  const auto offset = shape == PeakShape::kDirichlet ? sincRatioOffset : widenedPeakOffset;
+  peak.sub_row = peak.row + offset(sample(peak.row - 1, peak.col), peak.value,
+                                   sample(peak.row + 1, peak.col));
+  peak.sub_col = peak.col + offset(sample(peak.row, peak.col - 1), peak.value,
+                                   sample(peak.row, peak.col + 1));
+  return peak;
 }
 
 }  // namespace
@@ -151,27 +177,32 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
   }
   if (stats != nullptr) *stats = sums;
   const bool negative = -min_value > max_value;
-  const cv::Point at = negative ? min_at : max_at;
-  SurfacePeak peak;
-  peak.row = at.y;
-  peak.col = at.x;
-  const float sign = negative ? -1.0f : 1.0f;
-  peak.value = negative ? -min_value : max_value;
-  auto sample = [&](int r, int c) -> float {
-    r = wrap(r, surface.rows);
-    if (cyclic_cols) {
-      c = wrap(c, surface.cols);
-    } else if (c < 0 || c >= surface.cols) {
-      return 0.0f;
+  return refinedPeak(surface, negative ? min_at : max_at, negative, cyclic_cols, shape);
+}
+
+SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
+                             int half_cols, bool cyclic_cols, PeakShape shape) {
+  if (surface.empty()) throw InputError("findPeakInWindow: empty surface");
+  half_rows = std::clamp(half_rows, 0, (surface.rows - 1) / 2);
+  half_cols = std::clamp(half_cols, 0, (surface.cols - 1) / 2);
+  cv::Point best(wrap(centre.x, surface.cols), wrap(centre.y, surface.rows));
+  float best_value = -std::numeric_limits<float>::infinity();
+  for (int dr = -half_rows; dr <= half_rows; ++dr) {
+    const float* row = surface[wrap(centre.y + dr, surface.rows)];
+    for (int dc = -half_cols; dc <= half_cols; ++dc) {
+      int c = centre.x + dc;
+      if (cyclic_cols) {
+        c = wrap(c, surface.cols);
+      } else if (c < 0 || c >= surface.cols) {
+        continue;
+      }
+      if (row[c] > best_value) {
+        best_value = row[c];
+        best = cv::Point(c, wrap(centre.y + dr, surface.rows));
+      }
     }
-    return sign * surface(r, c);
-  };
-  const auto offset = shape == PeakShape::kDirichlet ? sincRatioOffset : widenedPeakOffset;
-  peak.sub_row = peak.row + offset(sample(peak.row - 1, peak.col), peak.value,
-                                   sample(peak.row + 1, peak.col));
-  peak.sub_col = peak.col + offset(sample(peak.row, peak.col - 1), peak.value,
-                                   sample(peak.row, peak.col + 1));
-  return peak;
+  }
+  return refinedPeak(surface, best, false, cyclic_cols, shape);
 }
 
 double peakToSidelobeRatio(const cv::Mat1f& surface, const SurfacePeak& peak,

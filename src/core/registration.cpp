@@ -111,7 +111,8 @@ double Registrar::logZoomPerBin() const { return std::log(context_->logPolarBase
 
 PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameSpectra& newer,
                                          RegistrationMethod method,
-                                         RegistrationSurfaces* surfaces) {
+                                         RegistrationSurfaces* surfaces,
+                                         const RegistrationPrior* prior) {
   const int n = context_->size();
   if (older.empty() || newer.empty()) throw InputError("registerPair: a frame is empty");
   if (older.grey.rows != n || newer.grey.rows != n || older.spectrum.size() != newer.spectrum.size()) {
@@ -135,11 +136,14 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   // candidate clears the window around the one before.
   correlateRotationZoom(older, newer);
   cv::Point peak;
-  for (int attempt = 0; attempt < rotation_zoom_candidates_; ++attempt) {
+  // The predicted peak first (when there is a prediction), then the highest peaks left.
+  const int attempts = rotation_zoom_candidates_ + (prior != nullptr ? 1 : 0);
+  for (int attempt = 0; attempt < attempts; ++attempt) {
     if (attempt > 0) clearAround(rotation_zoom_surface_, peak, kTriedPeakRadius);
+    const RegistrationPrior* window = attempt == 0 ? prior : nullptr;
     PairRegistration trial;
     RegistrationSurfaces trial_surfaces;
-    registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr);
+    registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, window);
     if (attempt == 0 || trial.confidence > result.confidence) {
       result = std::move(trial);
       result.rotation_zoom_candidate = attempt;
@@ -147,16 +151,25 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     }
     if (result.status == RegistrationStatus::kOk) break;
   }
+  if (prior != nullptr && result.status != RegistrationStatus::kOk) {
+    PairRegistration trial;
+    RegistrationSurfaces trial_surfaces;
+    registerOnPrior(older, newer, method, *prior, trial, surfaces ? &trial_surfaces : nullptr);
+    if (trial.confidence > result.confidence) {
+      result = std::move(trial);
+      if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+    }
+  }
   return result;
 }
 
 void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
                              RegistrationMethod method, PairRegistration& result, cv::Point& peak,
-                             RegistrationSurfaces* surfaces) {
+                             RegistrationSurfaces* surfaces, const RegistrationPrior* window) {
   const int n = context_->size();
-  const double psr_rotation_zoom = registerRotationZoom(method, result, peak);
+  const double psr_rotation_zoom = registerRotationZoom(method, result, peak, window);
   if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
-  const double psr_translation = registerTranslation(older, newer, method, result);
+  const double psr_translation = registerTranslation(older, newer, method, result, true);
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
     surfaces->translation_polar =
@@ -166,6 +179,45 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   result.confidence =
       std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
                confidenceFrom(psr_translation, kTranslationPsrFloor, kTranslationPsrGood));
+  result.status = result.confidence >= context_->config().min_confidence
+                      ? RegistrationStatus::kOk
+                      : RegistrationStatus::kLowConfidence;
+}
+
+void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer,
+                                RegistrationMethod method, const RegistrationPrior& prior,
+                                PairRegistration& result, RegistrationSurfaces* surfaces) {
+  const int n = context_->size();
+  const double log_zoom_per_bin = logZoomPerBin();
+  result.rotation = wrapAngle(prior.rotation);
+  result.zoom = std::exp(prior.log_zoom);
+  result.rotation_sigma = prior.rotation_sigma;
+  result.log_zoom_sigma = prior.log_zoom_sigma;
+  result.rotation_zoom_candidate = PairRegistration::kPredicted;
+  if (method == RegistrationMethod::kEnergyVectors) {
+    // The zoom energy vector at the predicted row, for the pattern matching of later pairs.
+    SurfacePeak at;
+    at.sub_row = n / 2 + prior.rotation * n / CV_PI;
+    at.sub_col = n / 2 - prior.log_zoom / log_zoom_per_bin;
+    at.row = ((static_cast<int>(std::lround(at.sub_row)) % n) + n) % n;
+    at.col = ((static_cast<int>(std::lround(at.sub_col)) % n) + n) % n;
+    at.value = rotation_zoom_surface_(at.row, at.col);
+    EnergyVectorOptions options = energyVectorOptions(context_->config());
+    options.cyclic_cols = true;
+    options.row_band = kEnergyRowBand;
+    result.zoom_energy = extractEnergyVector(rotation_zoom_surface_, at, options).values;
+  }
+  if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
+  // The prediction's rotation is not taken modulo a half turn: no half-turn test.
+  const double psr_translation = registerTranslation(older, newer, method, result, false);
+  if (surfaces != nullptr) {
+    surfaces->translation = surface_.clone();
+    surfaces->translation_polar =
+        method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
+    surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
+  }
+  // Nothing was measured of the rotation and zoom: the translation alone says whether they fit.
+  result.confidence = confidenceFrom(psr_translation, kTranslationPsrFloor, kTranslationPsrGood);
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
@@ -183,13 +235,22 @@ void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpec
 }
 
 double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistration& result,
-                                       cv::Point& peak_at) {
+                                       cv::Point& peak_at, const RegistrationPrior* window) {
   const int n = context_->size();
   const cv::Mat1f& surface = rotation_zoom_surface_;
-  SurfaceStats stats;
-  const SurfacePeak peak = findPeak(surface, true, &stats, PeakShape::kBroadened);
-  peak_at = cv::Point(peak.col, peak.row);
   const double log_zoom_per_bin = logZoomPerBin();
+  SurfaceStats stats;
+  SurfacePeak peak = findPeak(surface, true, &stats, PeakShape::kBroadened);
+  if (window != nullptr) {
+    // Rows: theta = (row - N/2) pi / N, modulo pi (the half turn is decided later); columns:
+    // ln s = -(col - N/2) ln b.
+    const cv::Point centre(static_cast<int>(std::lround(n / 2 - window->log_zoom / log_zoom_per_bin)),
+                           static_cast<int>(std::lround(n / 2 + window->rotation * n / CV_PI)));
+    const int half_rows = static_cast<int>(std::ceil(window->rotation_window * n / CV_PI));
+    const int half_cols = static_cast<int>(std::ceil(window->log_zoom_window / log_zoom_per_bin));
+    peak = findPeakInWindow(surface, centre, half_rows, half_cols, true, PeakShape::kBroadened);
+  }
+  peak_at = cv::Point(peak.col, peak.row);
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
   result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
   result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
@@ -212,7 +273,8 @@ double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistrati
 }
 
 double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
-                                      RegistrationMethod method, PairRegistration& result) {
+                                      RegistrationMethod method, PairRegistration& result,
+                                      bool test_half_turn) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
   // Unless that moves no pixel noticeably: then the older frame's own spectrum (the same
@@ -229,7 +291,7 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   }
   const cv::Mat2f& older_spectrum = result.warped ? warped_spectrum_ : older.spectrum;
 
-  if (context_->config().resolve_half_turn) {
+  if (test_half_turn && context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
     // hypothesis needs no second warp; a low-resolution correlation decides between the two
     // and only the winner gets the full-size inverse FFT.

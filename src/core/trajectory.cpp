@@ -67,6 +67,7 @@ PoseIntegrator::PoseIntegrator(double initial_altitude, double fx)
 void PoseIntegrator::reset(double stamp) {
   pose_ = Pose4{};
   pose_.stamp = stamp;
+  last_step_covariance_ = cv::Matx44d::zeros();
 }
 
 const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
@@ -105,7 +106,9 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
   for (int r = 0; r < 4; ++r) {
     for (int col = 0; col < 4; ++col) sigma(r, col) = pose_.covariance(r, col);
   }
-  Mat4 next = f * sigma * f.transpose() + g * q * g.transpose();
+  Mat4 added = g * q * g.transpose();
+  added = 0.5 * (added + added.transpose());
+  Mat4 next = f * sigma * f.transpose() + added;
   next = 0.5 * (next + next.transpose());
 
   const Vec2 world_step = flip * image_step;
@@ -115,7 +118,10 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
   pose_.yaw = wrapToPi(-psi);
   pose_.stamp = stamp;
   for (int r = 0; r < 4; ++r) {
-    for (int col = 0; col < 4; ++col) pose_.covariance(r, col) = next(r, col);
+    for (int col = 0; col < 4; ++col) {
+      pose_.covariance(r, col) = next(r, col);
+      last_step_covariance_(r, col) = added(r, col);
+    }
   }
   return pose_;
 }
@@ -123,6 +129,7 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
 const Pose4& PoseIntegrator::hold(double stamp, const cv::Matx44d& extra_covariance) {
   pose_.stamp = stamp;
   pose_.covariance += extra_covariance;
+  last_step_covariance_ = extra_covariance;
   return pose_;
 }
 
