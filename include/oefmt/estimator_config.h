@@ -63,6 +63,16 @@ struct TrackingConfig {
   /// sigma relative to the predicted length (+1 px); it breaks the tie when one pair's correlation
   /// peak is an alias and its loop partner has no pattern match. 0 = off.
   double motion_prior_sigma = 0.3;
+  /// Largest acceleration of the vehicle [m/s^2]. The motion so far predicts where the next
+  /// pair's translation peak lies; the window around that prediction is how far the vehicle can
+  /// depart from it between two frames (fx a dt^2 / altitude pixels). A weaker peak inside the
+  /// window is accepted where a peak anywhere in the image would not be, and the highest peak
+  /// outside the window and off the direction of motion (a repetitive texture's alias) is not
+  /// taken at full confidence.
+  double max_acceleration = 10.0;
+  /// Distance to the scene [m] the acceleration window assumes when the altitude is unknown:
+  /// low on purpose, which makes the window wide rather than wrong.
+  double assumed_altitude = 5.0;
 
   void validate() const;
 };

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "oefmt/config.h"
+#include "oefmt/phase_correlation.h"
 #include "oefmt/spectra.h"
 
 namespace oefmt {
@@ -48,6 +49,12 @@ struct PairRegistration {
   int rotation_zoom_candidate = 0;
   static constexpr int kPredicted = -1;
   bool half_turn = false;           ///< the 180-degree alternative won
+  /// The translation peak came from the prior's window, not the surface's highest peak (which
+  /// was off the predicted motion or too weak).
+  bool translation_from_window = false;
+  /// The surface's highest peak was off the predicted motion and nothing in the window stood
+  /// out: the registration is not confident.
+  bool translation_implausible = false;
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
   bool warped = true;
@@ -68,6 +75,15 @@ struct RegistrationPrior {
   double log_zoom_sigma = 0.0;   ///< 1-sigma of the prediction [ln s]
   double rotation_window = 0.0;  ///< half width of the window [rad]
   double log_zoom_window = 0.0;  ///< half width of the window [ln s]
+  /// Predicted translation d [px of the newer frame] of the followed depth layer and the radius
+  /// of the window around it [px]; radius 0: no translation prediction. The highest translation
+  /// peak stands when it lies in the window or on the predicted direction of motion (another
+  /// depth layer moves along it, up to twice or half as far). Otherwise, and when it is too weak,
+  /// the highest peak within the window is taken if it stands out from the surface as a peak
+  /// that could be anywhere in a window of that size would have to; if none does, the
+  /// registration is not confident (a repetitive texture's alias, or a pair that does not match).
+  cv::Point2d translation;
+  double translation_radius = 0.0;
 };
 
 /// Correlation surfaces of the last registration, for diagnostics and plots.
@@ -111,10 +127,11 @@ class Registrar {
   // The rotation/zoom correlation surface of the pair, into rotation_zoom_surface_.
   void correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer);
   // Rotation, zoom, translation and confidence with the highest peak left on the rotation/zoom
-  // surface, or within the prior's window; `peak` receives it.
+  // surface, or (in_window) the highest within the prior's window; `peak` receives it. The
+  // prior's translation, if any, guides the translation peak either way.
   void registerOnce(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
                     PairRegistration& result, cv::Point& peak, RegistrationSurfaces* surfaces,
-                    const RegistrationPrior* window);
+                    const RegistrationPrior* prior, bool in_window);
   // Each returns the peak-to-sidelobe ratio of its correlation surface.
   double registerRotationZoom(RegistrationMethod method, PairRegistration& result, cv::Point& peak,
                               const RegistrationPrior* window);
@@ -122,9 +139,14 @@ class Registrar {
   void registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
                        const RegistrationPrior& prior, PairRegistration& result,
                        RegistrationSurfaces* surfaces);
+  // The translation's confidence (0..1) instead of a peak-to-sidelobe ratio.
   double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
                              RegistrationMethod method, PairRegistration& result,
-                             bool test_half_turn);
+                             bool test_half_turn, const RegistrationPrior* prior);
+  // The translation peak of surface_: the highest, or the prior's window's; sets the result's
+  // window flags and returns the peak's confidence.
+  double chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
+                               PairRegistration& result);
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;

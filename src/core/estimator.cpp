@@ -44,6 +44,8 @@ constexpr double kPriorWindowBins = 6.0;
 // Steps whose median predicts the next rotation and zoom: a yaw or climb rate that changes
 // shows in the median after two steps, a single wrong step not at all.
 constexpr std::size_t kPredictionSteps = 3;
+// Smallest radius of the translation window [px]: sub-pixel noise and rounding.
+constexpr double kTranslationWindowFloor = 2.0;
 
 // Pair 0-2 is not registered when even its slowest depth layer is predicted to move more than
 // this fraction of N along an axis: the circular correlation folds shifts beyond N/2 to the
@@ -120,12 +122,17 @@ struct Estimator::State {
   void advance(WindowFrame&& frame, const PairMotion& step, std::vector<float>&& next_translation01,
                Estimate& est);
   cv::Matx44d heldGrowth() const;
-  // Whether pair 0-2 of a window whose newest frame is `intervals12` after frame 1 can be
-  // registered: pair 0-1's motion continued must stay within kMaxPairShiftFraction of N.
-  bool pair02InReach(int intervals12) const;
-  // The rotation/zoom that the last motion predicts over `intervals` frame intervals, starting
-  // from `start` (pair 0-1 for pair 0-2); none without a motion or outside oefmt mode.
-  std::optional<RegistrationPrior> predictedRotationZoom(int intervals, const PairMotion* start) const;
+  // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
+  // registered: even its slowest layer (of those pair 0-1 saw) must stay within
+  // kMaxPairShiftFraction of N along both axes.
+  bool shiftInReach(const cv::Point2d& followed) const;
+  // The frame failed and the next one could not be registered against frame 1: the window
+  // moves on to it, with the predicted step as its motion.
+  void slideTo(WindowFrame&& frame, const PairMotion& predicted);
+  // The rotation, zoom and translation that the motion so far predicts for a pair spanning
+  // `intervals` frame intervals and `seconds` after frame 1, starting from `start` (pair 0-1
+  // for pair 0-2); none without a motion or outside oefmt mode.
+  std::optional<RegistrationPrior> predictedPair(int intervals, double seconds, const PairMotion* start) const;
 
   const EstimatorConfig& config;
   Registrar registrar;
@@ -181,8 +188,8 @@ class PendingPairGuard {
   int exceptions_;
 };
 
-std::optional<RegistrationPrior> Estimator::State::predictedRotationZoom(int intervals,
-                                                                        const PairMotion* start) const {
+std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, double seconds,
+                                                                const PairMotion* start) const {
   if (config.mode != EstimatorMode::kOefmt || recent_steps.empty()) return std::nullopt;
   const int n = config.registration.size;
   // The median of the last steps' rates: one wrong step does not move the prediction.
@@ -197,6 +204,7 @@ std::optional<RegistrationPrior> Estimator::State::predictedRotationZoom(int int
   prior.log_zoom = median([](const PairMotion& m) { return m.log_zoom; }) * intervals;
   double rotation_sigma = median([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
   double log_zoom_sigma = median([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
+  const double rotation12 = prior.rotation, log_zoom12 = prior.log_zoom;
   if (start != nullptr) {
     prior.rotation += start->rotation;
     prior.log_zoom += start->log_zoom;
@@ -209,21 +217,43 @@ std::optional<RegistrationPrior> Estimator::State::predictedRotationZoom(int int
   // frame interval's change of the rates (a third of the window).
   prior.rotation_sigma = std::hypot(rotation_sigma, kPriorWindowBins * CV_PI / n / 3.0);
   prior.log_zoom_sigma = std::hypot(log_zoom_sigma, kPriorWindowBins * registrar.logZoomPerBin() / 3.0);
+  if (last_step && seconds > 0.0) {
+    // The translation per interval in the camera's axes (steady in a coordinated turn), and how
+    // far the last steps strayed from it.
+    const cv::Point2d per_interval(median([](const PairMotion& m) { return m.translation.x; }),
+                                   median([](const PairMotion& m) { return m.translation.y; }));
+    double spread = 0.0;
+    for (const PairMotion& m : recent_steps) {
+      spread = std::max(spread, cv::norm(m.translation - per_interval) +
+                                    std::sqrt(std::max(cv::trace(m.translation_covariance), 0.0)));
+    }
+    prior.translation = per_interval * intervals;
+    double uncertainty = spread * intervals;
+    if (start != nullptr) {
+      // d02 = s12 R(theta12) d01 + d12.
+      prior.translation += rotateImageVector(start->translation, rotation12) * std::exp(log_zoom12);
+      uncertainty += std::sqrt(std::max(cv::trace(start->translation_covariance), 0.0));
+    }
+    const double metres = config.altitude > 0.0 ? integrator.altitude()
+                                                : config.tracking.assumed_altitude * integrator.altitude();
+    prior.translation_radius = config.effectiveFx() * config.tracking.max_acceleration * seconds * seconds /
+                                   std::max(metres, 1e-6) +
+                               3.0 * uncertainty + kTranslationWindowFloor;
+  }
   return prior;
 }
 
-bool Estimator::State::pair02InReach(int intervals12) const {
-  const double length01 = motion01.shift();
-  if (!(length01 > 0.0)) return true;
+bool Estimator::State::shiftInReach(const cv::Point2d& followed) const {
   // The slowest layer pair 0-1 saw (the farthest plane) moves the least.
-  double slowest = length01;
-  for (const EnergyPeak& peak : energyPeaks(translation01, config.tracking.layer_min_fraction)) {
-    slowest = std::min(slowest, peak.bin * registrar.shiftPerBin());
+  double fraction = 1.0;
+  const double length01 = motion01.shift();
+  if (have01 && length01 > 0.0) {
+    for (const EnergyPeak& peak : energyPeaks(translation01, config.tracking.layer_min_fraction)) {
+      fraction = std::min(fraction, peak.bin * registrar.shiftPerBin() / length01);
+    }
   }
-  const cv::Point2d predicted =
-      motion01.translation * (slowest / length01 * double(gap01 + intervals12) / gap01);
   const double limit = kMaxPairShiftFraction * config.registration.size;
-  return std::fabs(predicted.x) <= limit && std::fabs(predicted.y) <= limit;
+  return std::fabs(followed.x * fraction) <= limit && std::fabs(followed.y * fraction) <= limit;
 }
 
 cv::Matx44d Estimator::State::heldGrowth() const {
@@ -260,6 +290,13 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
     predicted.log_zoom_sigma = std::hypot(predicted.log_zoom_sigma, kPredictedLogZoomSigma);
     integrator.integrate(predicted, frame.stamp);
     est.state = TrackingState::kPredicted;
+    // The next frame would be registered against frame 1 over one more interval: at low overlap
+    // that pair is out of reach, and every later frame would fail too.
+    const int next_intervals = static_cast<int>(frame.index - f1->index) + 1;
+    if (textured && f1 && !shiftInReach(last_step->translation * next_intervals)) {
+      slideTo(std::move(frame), predicted);
+      return;
+    }
   } else {
     integrator.hold(frame.stamp, heldGrowth());
     est.state = TrackingState::kHeld;
@@ -277,6 +314,15 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   } else {
     f1.reset();
   }
+}
+
+void Estimator::State::slideTo(WindowFrame&& frame, const PairMotion& predicted) {
+  // Pair 0-1's energy vectors stay the scale reference (its speed is the one predicted).
+  anchor.reset();
+  motion01 = predicted;
+  gap01 = 1;
+  f0 = std::move(f1);
+  f1 = std::move(frame);
 }
 
 PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
@@ -315,7 +361,7 @@ PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
 PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, bool with02) {
   Clock::time_point t = Clock::now();
   if (with02) {
-    if (!pending02.valid()) prior02 = predictedRotationZoom(est.frame_gap, &motion01);
+    if (!pending02.valid()) prior02 = predictedPair(est.frame_gap, frame.stamp - f1->stamp, &motion01);
     est.registration02 = pending02.valid()
                              ? pending02.get()
                              : registrar02.registerPair(f0->spectra, frame.spectra,
@@ -505,14 +551,16 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                                           : RegistrationMethod::kEnergyVectors;
     const Clock::time_point t = Clock::now();
     const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
-                        s.pair02InReach(static_cast<int>(frame.index - s.f1->index));
+                        s.shiftInReach(s.motion01.translation *
+                                       (double(s.gap01 + frame.index - s.f1->index) / s.gap01));
     if (with02 && config_.parallel_registrations) {
       // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
       // cached spectra; each Registrar has its own scratch). Collected in oefmtStep; discarded
       // if pair 1-2 fails.
       const FrameSpectra& older = s.f0->spectra;
       const FrameSpectra& newer = frame.spectra;
-      s.prior02 = s.predictedRotationZoom(static_cast<int>(frame.index - s.f1->index), &s.motion01);
+      s.prior02 = s.predictedPair(static_cast<int>(frame.index - s.f1->index), frame.stamp - s.f1->stamp,
+                                  &s.motion01);
       s.pending02 = s.worker02.submit([&s, &older, &newer] {
         return s.registrar02.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr,
                                           s.prior02 ? &*s.prior02 : nullptr);
@@ -521,7 +569,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     const PendingPairGuard pending_guard(s.pending02);
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
-    s.prior12 = s.predictedRotationZoom(est.frame_gap, nullptr);
+    s.prior12 = s.predictedPair(est.frame_gap, frame.stamp - s.f1->stamp, nullptr);
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
                                                   s.prior12 ? &*s.prior12 : nullptr);
     est.registration_ms += msSince(t);

@@ -194,7 +194,9 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   integer("max_failed_frames", t.max_failed_frames),
                   boolean("predict_failed_frames", t.predict_failed_frames),
                   number("prediction_sigma", t.prediction_sigma),
-                  number("motion_prior_sigma", t.motion_prior_sigma)},
+                  number("motion_prior_sigma", t.motion_prior_sigma),
+                  number("max_acceleration", t.max_acceleration),
+                  number("assumed_altitude", t.assumed_altitude)},
                  [&t] { t.validate(); }});
   UncertaintyConfig& u = c.uncertainty;
   all.push_back({"uncertainty",
@@ -276,6 +278,8 @@ void TrackingConfig::validate() const {
           "must be in [0, 1000]");
   require(finiteIn(prediction_sigma, 0.0, 100.0), "prediction_sigma", "must be in [0, 100]");
   require(finiteIn(motion_prior_sigma, 0.0, 100.0), "motion_prior_sigma", "must be in [0, 100]");
+  require(finiteIn(max_acceleration, 0.01, 1000.0), "max_acceleration", "must be in [0.01, 1000] m/s^2");
+  require(finiteIn(assumed_altitude, 0.01, 1e5), "assumed_altitude", "must be in [0.01, 1e5] m");
 }
 
 void UncertaintyConfig::validate() const {

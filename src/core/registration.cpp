@@ -140,10 +140,10 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   const int attempts = rotation_zoom_candidates_ + (prior != nullptr ? 1 : 0);
   for (int attempt = 0; attempt < attempts; ++attempt) {
     if (attempt > 0) clearAround(rotation_zoom_surface_, peak, kTriedPeakRadius);
-    const RegistrationPrior* window = attempt == 0 ? prior : nullptr;
     PairRegistration trial;
     RegistrationSurfaces trial_surfaces;
-    registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, window);
+    registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, prior,
+                 attempt == 0 && prior != nullptr);
     if (attempt == 0 || trial.confidence > result.confidence) {
       result = std::move(trial);
       result.rotation_zoom_candidate = attempt;
@@ -165,11 +165,13 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
 
 void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
                              RegistrationMethod method, PairRegistration& result, cv::Point& peak,
-                             RegistrationSurfaces* surfaces, const RegistrationPrior* window) {
+                             RegistrationSurfaces* surfaces, const RegistrationPrior* prior,
+                             bool in_window) {
   const int n = context_->size();
-  const double psr_rotation_zoom = registerRotationZoom(method, result, peak, window);
+  const double psr_rotation_zoom = registerRotationZoom(method, result, peak, in_window ? prior : nullptr);
   if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
-  const double psr_translation = registerTranslation(older, newer, method, result, true);
+  const double translation_confidence =
+      registerTranslation(older, newer, method, result, true, prior);
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
     surfaces->translation_polar =
@@ -178,7 +180,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   }
   result.confidence =
       std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
-               confidenceFrom(psr_translation, kTranslationPsrFloor, kTranslationPsrGood));
+               translation_confidence);
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
@@ -209,7 +211,7 @@ void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& n
   }
   if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
   // The prediction's rotation is not taken modulo a half turn: no half-turn test.
-  const double psr_translation = registerTranslation(older, newer, method, result, false);
+  const double translation_confidence = registerTranslation(older, newer, method, result, false, &prior);
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
     surfaces->translation_polar =
@@ -217,7 +219,7 @@ void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& n
     surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
   }
   // Nothing was measured of the rotation and zoom: the translation alone says whether they fit.
-  result.confidence = confidenceFrom(psr_translation, kTranslationPsrFloor, kTranslationPsrGood);
+  result.confidence = translation_confidence;
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
@@ -274,7 +276,7 @@ double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistrati
 
 double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
                                       RegistrationMethod method, PairRegistration& result,
-                                      bool test_half_turn) {
+                                      bool test_half_turn, const RegistrationPrior* prior) {
   const int n = context_->size();
   // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
   // Unless that moves no pixel noticeably: then the older frame's own spectrum (the same
@@ -307,13 +309,12 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn);
   fft.inverseInPlace(cross_power_);
   surface_ = fft.realView(cross_power_);
-  SurfaceStats stats;
-  const SurfacePeak peak = findPeak(surface_, true, &stats);
+  SurfacePeak peak;
+  const double confidence = chooseTranslationPeak(prior, peak, result);
   result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
   result.direction = std::atan2(result.translation.y, result.translation.x);
   result.shift = std::hypot(result.translation.x, result.translation.y);
   result.translation_peak = peak.value;
-  const double psr = peakToSidelobeRatio(surface_, peak, stats);
 
   if (method == RegistrationMethod::kEnergyVectors) {
     // Polar unwrap: the depths of the scene lie along one direction at different radii (2.6).
@@ -336,7 +337,55 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
     result.shift_sigma = std::max(widths.x, widths.y);
     result.direction_sigma = std::min(CV_PI, result.shift_sigma / std::max(result.shift, 1e-9));
   }
-  return psr;
+  return confidence;
+}
+
+double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
+                                        PairRegistration& result) {
+  const int n = context_->size();
+  SurfaceStats stats;
+  peak = findPeak(surface_, true, &stats);
+  const double global = confidenceFrom(peakToSidelobeRatio(surface_, peak, stats),
+                                       kTranslationPsrFloor, kTranslationPsrGood);
+  result.translation_from_window = false;
+  result.translation_implausible = false;
+  if (prior == nullptr || !(prior->translation_radius > 0.0)) return global;
+
+  const double radius = std::min(prior->translation_radius, 0.25 * n);
+  const cv::Point2d predicted = prior->translation;
+  const cv::Point2d highest(peak.sub_col - n / 2, peak.sub_row - n / 2);
+  const int half = static_cast<int>(std::ceil(radius));
+  const SurfacePeak near = findPeakInWindow(
+      surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
+                          static_cast<int>(std::lround(n / 2 + predicted.y))),
+      half, half, true);
+  // The noise of a correlation surface reaches higher the more cells it has: the floors were
+  // set for the largest of the N^2 cells; for the largest of a window's cells they shrink with
+  // the logarithm of the count (the tail of the surface's values is about exponential).
+  const double cells = (2.0 * half + 1.0) * (2.0 * half + 1.0);
+  const double shrink = std::log(cells) / std::log(static_cast<double>(n) * n);
+  const double windowed = confidenceFrom(peakToSidelobeRatio(surface_, near, stats),
+                                         kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink) *
+                          std::clamp(double(near.value) / std::max(double(peak.value), 1e-12), 0.0, 1.0);
+  // The highest peak is plausible in the window, or on the predicted direction at up to twice or
+  // half the predicted length (another depth layer of the same motion).
+  const double length = std::hypot(predicted.x, predicted.y);
+  bool plausible = std::hypot(highest.x - predicted.x, highest.y - predicted.y) <= radius;
+  if (!plausible && length > radius) {
+    const cv::Point2d along = predicted * (1.0 / length);
+    const double projection = highest.x * along.x + highest.y * along.y;
+    const double across = std::fabs(highest.y * along.x - highest.x * along.y);
+    plausible = across <= radius && projection >= 0.5 * length && projection <= 2.0 * length;
+  }
+  if (plausible && global >= windowed) return global;
+  if (windowed > 0.0) {
+    peak = near;
+    result.translation_from_window = true;
+    return windowed;
+  }
+  if (plausible) return global;
+  result.translation_implausible = true;
+  return 0.0;
 }
 
 }  // namespace oefmt
