@@ -47,6 +47,33 @@ cv::Mat1f textureFromFile(const std::string& path) {
   return tile;
 }
 
+// A layer's procedural texture of a resolved style (not kMixed).
+cv::Mat1f layerTexture(TextureStyle style, int size, std::uint32_t seed, double feature_texels,
+                       double pattern_texels) {
+  switch (style) {
+    case TextureStyle::kNatural: return naturalTexture(size, seed, feature_texels);
+    case TextureStyle::kBrick: return brickTexture(size, seed, pattern_texels);
+    case TextureStyle::kTiles: return tileTexture(size, seed, pattern_texels);
+    case TextureStyle::kNoise:
+      // Plain noise is smooth at the coarse scale: finer structures keep it rich in detail.
+      return tileableTexture(size, seed, style, std::max(2.0, feature_texels / 4.0));
+    default: return tileableTexture(size, seed, style, feature_texels);
+  }
+}
+
+// Walls are lit from the east-south-east, tops from straight above at full brightness: every
+// wall is darker than a top of its texture, and walls facing different ways differ.
+float wallShade(Facing facing) {
+  switch (facing) {
+    case Facing::kEast: return 0.72f;
+    case Facing::kSouth: return 0.62f;
+    case Facing::kNorth: return 0.5f;
+    case Facing::kWest: return 0.42f;
+    case Facing::kUp: break;
+  }
+  return 1.0f;
+}
+
 }  // namespace
 
 void SceneConfig::validate() const {
@@ -60,6 +87,12 @@ void SceneConfig::validate() const {
   require(texel > 0.0 && std::isfinite(texel), "texel must be > 0");
   require(texture_size >= 64, "texture_size must be >= 64");
   require(feature_texels >= 2.0, "feature_texels must be >= 2");
+  for (double pattern : pattern_texels) {
+    require(pattern > 0.0 && std::isfinite(pattern), "pattern_texels must be > 0");
+  }
+  require(texture_std >= 0.0 && texture_std <= 0.5, "texture_std must be in [0, 0.5]");
+  // The renderer's layer map codes level k as k and its walls as 128 + k.
+  require(levels.size() <= 126, "at most 126 raised levels");
   double shares = 0.0;
   for (const BlockLevel& level : levels) {
     require(level.height > 0.0 && std::isfinite(level.height), "level heights must be > 0");
@@ -81,6 +114,11 @@ double SceneConfig::highestTop() const {
   return top;
 }
 
+double SceneConfig::patternTexels(int layer) const {
+  if (pattern_texels.empty()) return 64.0;
+  return pattern_texels[std::min(static_cast<std::size_t>(layer), pattern_texels.size() - 1)];
+}
+
 Scene::Scene(const SceneConfig& config)
     : config_(config), seed_hash_(mix(config.seed)) {
   config_.validate();
@@ -88,7 +126,7 @@ Scene::Scene(const SceneConfig& config)
   inverse_cell_ = 1.0 / config_.cell_size;
   inverse_terrace_side_ = 1.0 / terrace_side_;
   inverse_texel_ = 1.0 / config_.texel;
-  const TextureStyle styles[] = {TextureStyle::kCells, TextureStyle::kStripes, TextureStyle::kNoise};
+  highest_top_ = config_.highestTop();
   const int layers = static_cast<int>(config_.levels.size()) + 1;
   textures_.resize(layers);
   // Layers in parallel: the textures are the slowest part of setting up a flight.
@@ -97,12 +135,11 @@ Scene::Scene(const SceneConfig& config)
       const bool from_file = layer < static_cast<int>(config_.texture_files.size()) &&
                              !config_.texture_files[layer].empty();
       const int size = layer == 0 ? config_.texture_size : std::max(64, config_.texture_size / 2);
-      const TextureStyle style = styles[layer % 3];
-      // Plain noise is smooth at the coarse scale: finer structures keep it rich in detail.
-      const double feature = style == TextureStyle::kNoise ? std::max(2.0, config_.feature_texels / 4.0)
-                                                            : config_.feature_texels;
       textures_[layer] = from_file ? textureFromFile(config_.texture_files[layer])
-                                   : tileableTexture(size, config_.seed * 7919u + layer, style, feature);
+                                   : layerTexture(layerTextureStyle(config_.texture_styles, layer), size,
+                                                  config_.seed * 7919u + layer, config_.feature_texels,
+                                                  config_.patternTexels(layer));
+      if (config_.texture_std > 0.0) textures_[layer] = withContrast(textures_[layer], config_.texture_std);
     }
   });
   for (const cv::Mat1f& texture : textures_) inverse_texture_size_.emplace_back(1.0 / texture.cols, 1.0 / texture.rows);
@@ -193,6 +230,10 @@ int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
   const long long ci = static_cast<long long>(fci), cj = static_cast<long long>(fcj);
   *ti = floorDivide(ci, config_.terrace_cells);
   *tj = floorDivide(cj, config_.terrace_cells);
+  return cellCode(ci, cj);
+}
+
+int Scene::cellCode(long long ci, long long cj) const {
   const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
   if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
     return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
@@ -200,17 +241,18 @@ int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
   return computeCellCode(ci, cj);
 }
 
+double Scene::topHeight(int level, long long ti, long long tj, double x, double y) const {
+  const cv::Vec2d slope = terraceSlope(ti, tj, level);
+  return config_.levels[level].height + slope[0] * (x - (ti + 0.5) * terrace_side_) +
+         slope[1] * (y - (tj + 0.5) * terrace_side_);
+}
+
 int Scene::layerAt(double x, double y, double* height) const {
   long long ti = 0, tj = 0;
   const int code = topAt(x, y, &ti, &tj);
   if (height) *height = 0.0;
   if (code == 0) return 0;
-  const int level = code - 1;
-  if (height) {
-    const cv::Vec2d slope = terraceSlope(ti, tj, level);
-    *height = config_.levels[level].height + slope[0] * (x - (ti + 0.5) * terrace_side_) +
-              slope[1] * (y - (tj + 0.5) * terrace_side_);
-  }
+  if (height) *height = topHeight(code - 1, ti, tj, x, y);
   return code;
 }
 
@@ -262,7 +304,90 @@ SceneHit Scene::cast(const cv::Vec3d& o, const cv::Vec3d& d) const {
     }
   }
   best.z = o[2] + best.t * d[2];
+  if (config_.walls && !config_.levels.empty()) castWalls(o, d, &best);
   return best;
+}
+
+void Scene::castWalls(const cv::Vec3d& o, const cv::Vec3d& d, SceneHit* best) const {
+  // Nothing stands above the highest top: walk the cells under the ray from where it descends
+  // through that height to its hit so far (a top or the ground), nearest first, so the first
+  // wall met is the nearest one.
+  const double t_start = std::max(0.0, (o[2] - highest_top_) / -d[2]);
+  if (!(t_start < best->t)) return;
+  const double cell = config_.cell_size;
+  long long ci = floorIndex((o[0] + t_start * d[0]) * inverse_cell_);
+  long long cj = floorIndex((o[1] + t_start * d[1]) * inverse_cell_);
+  // Per axis: the ray parameter at the next cell boundary, between boundaries, and the step.
+  const auto axis = [&](double origin, double direction, long long index, double* next, double* delta) {
+    if (direction == 0.0) {
+      *next = *delta = HUGE_VAL;
+      return;
+    }
+    *next = ((index + (direction > 0.0 ? 1 : 0)) * cell - origin) / direction;
+    *delta = cell / std::fabs(direction);
+  };
+  double next_x = 0.0, delta_x = 0.0, next_y = 0.0, delta_y = 0.0;
+  axis(o[0], d[0], ci, &next_x, &delta_x);
+  axis(o[1], d[1], cj, &next_y, &delta_y);
+  const int step_i = d[0] > 0.0 ? 1 : -1, step_j = d[1] > 0.0 ? 1 : -1;
+  // The ray's parameter range inside [low, high] along one axis (empty if it never is).
+  const auto slab = [](double origin, double direction, double low, double high, double* in, double* out) {
+    if (direction == 0.0) {
+      *in = origin >= low && origin <= high ? -HUGE_VAL : HUGE_VAL;
+      *out = HUGE_VAL;
+      return;
+    }
+    const double a = (low - origin) / direction, b = (high - origin) / direction;
+    *in = std::min(a, b);
+    *out = std::max(a, b);
+  };
+  const double gap = config_.gap;
+  for (double t_cell = t_start; t_cell < best->t;) {
+    const int code = cellCode(ci, cj);
+    if (code != 0) {
+      // The prism's inset square: the ray enters it at t_in through the wall of the later slab.
+      double tx_in = 0.0, tx_out = 0.0, ty_in = 0.0, ty_out = 0.0;
+      slab(o[0], d[0], (ci + gap) * cell, (ci + 1 - gap) * cell, &tx_in, &tx_out);
+      slab(o[1], d[1], (cj + gap) * cell, (cj + 1 - gap) * cell, &ty_in, &ty_out);
+      const double t_in = std::max(tx_in, ty_in);
+      if (t_in < std::min(tx_out, ty_out) && t_in > 0.0 && t_in < best->t) {
+        const double x = o[0] + t_in * d[0], y = o[1] + t_in * d[1], z = o[2] + t_in * d[2];
+        const int level = code - 1;
+        // Above the top's edge there, the ray passes over the wall (and may land on the top).
+        if (z <= topHeight(level, floorDivide(ci, config_.terrace_cells), floorDivide(cj, config_.terrace_cells), x, y)) {
+          best->layer = code;
+          best->t = t_in;
+          best->x = x;
+          best->y = y;
+          best->z = z;
+          best->facing = tx_in >= ty_in ? (d[0] > 0.0 ? Facing::kWest : Facing::kEast)
+                                        : (d[1] > 0.0 ? Facing::kSouth : Facing::kNorth);
+          return;
+        }
+      }
+    }
+    if (next_x < next_y) {
+      t_cell = next_x;
+      next_x += delta_x;
+      ci += step_i;
+    } else {
+      t_cell = next_y;
+      next_y += delta_y;
+      cj += step_j;
+    }
+  }
+}
+
+float Scene::shade(const SceneHit& hit) const {
+  switch (hit.facing) {
+    case Facing::kUp: return sample(hit.layer, hit.x, hit.y);
+    // The texture stands upright on the wall: its rows along z, its columns along the wall.
+    case Facing::kEast:
+    case Facing::kWest: return wallShade(hit.facing) * sample(hit.layer, hit.y, hit.z);
+    case Facing::kNorth:
+    case Facing::kSouth: break;
+  }
+  return wallShade(hit.facing) * sample(hit.layer, hit.x, hit.z);
 }
 
 float Scene::sample(int layer, double x, double y) const {
