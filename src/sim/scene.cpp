@@ -222,6 +222,15 @@ cv::Vec2d Scene::terraceSlope(long long ti, long long tj, int level) const {
   return level_slope_[level] * directions_[direction];
 }
 
+// Inline: the wall walk calls it for every cell it crosses.
+inline int Scene::cellCode(long long ci, long long cj) const {
+  const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
+  if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
+    return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
+  }
+  return computeCellCode(ci, cj);
+}
+
 int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
   const double cx = x * inverse_cell_, cy = y * inverse_cell_;
   const double fci = std::floor(cx), fcj = std::floor(cy);
@@ -231,14 +240,6 @@ int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
   *ti = floorDivide(ci, config_.terrace_cells);
   *tj = floorDivide(cj, config_.terrace_cells);
   return cellCode(ci, cj);
-}
-
-int Scene::cellCode(long long ci, long long cj) const {
-  const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
-  if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
-    return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
-  }
-  return computeCellCode(ci, cj);
 }
 
 double Scene::topHeight(int level, long long ti, long long tj, double x, double y) const {
@@ -317,55 +318,63 @@ void Scene::castWalls(const cv::Vec3d& o, const cv::Vec3d& d, SceneHit* best) co
   const double cell = config_.cell_size;
   long long ci = floorIndex((o[0] + t_start * d[0]) * inverse_cell_);
   long long cj = floorIndex((o[1] + t_start * d[1]) * inverse_cell_);
-  // Per axis: the ray parameter at the next cell boundary, between boundaries, and the step.
-  const auto axis = [&](double origin, double direction, long long index, double* next, double* delta) {
-    if (direction == 0.0) {
-      *next = *delta = HUGE_VAL;
-      return;
-    }
-    *next = ((index + (direction > 0.0 ? 1 : 0)) * cell - origin) / direction;
-    *delta = cell / std::fabs(direction);
-  };
-  double next_x = 0.0, delta_x = 0.0, next_y = 0.0, delta_y = 0.0;
-  axis(o[0], d[0], ci, &next_x, &delta_x);
-  axis(o[1], d[1], cj, &next_y, &delta_y);
-  const int step_i = d[0] > 0.0 ? 1 : -1, step_j = d[1] > 0.0 ? 1 : -1;
-  // The ray's parameter range inside [low, high] along one axis (empty if it never is).
-  const auto slab = [](double origin, double direction, double low, double high, double* in, double* out) {
+  // Reciprocals: the walk multiplies instead of dividing (an axis the ray does not move along
+  // never reaches a boundary).
+  const double inverse_x = d[0] != 0.0 ? 1.0 / d[0] : 0.0, inverse_y = d[1] != 0.0 ? 1.0 / d[1] : 0.0;
+  // The ray's parameter range inside [low, high] along one axis (all of it, or none, for an
+  // axis it does not move along).
+  const auto slab = [](double origin, double direction, double inverse, double low, double high, double* in,
+                       double* out) {
     if (direction == 0.0) {
       *in = origin >= low && origin <= high ? -HUGE_VAL : HUGE_VAL;
       *out = HUGE_VAL;
       return;
     }
-    const double a = (low - origin) / direction, b = (high - origin) / direction;
+    const double a = (low - origin) * inverse, b = (high - origin) * inverse;
     *in = std::min(a, b);
     *out = std::max(a, b);
   };
-  const double gap = config_.gap;
+  const double inset = config_.gap * cell;
+  // Whether the ray enters the block of cell (ci, cj) through a side wall before *best; if so
+  // *best becomes that wall.
+  const auto wall = [&](long long i, long long j) {
+    const int code = cellCode(i, j);
+    if (code == 0) return false;
+    // The block's inset square: the ray enters it at t_in through the wall of the later slab.
+    double tx_in = 0.0, tx_out = 0.0, ty_in = 0.0, ty_out = 0.0;
+    slab(o[0], d[0], inverse_x, i * cell + inset, (i + 1) * cell - inset, &tx_in, &tx_out);
+    slab(o[1], d[1], inverse_y, j * cell + inset, (j + 1) * cell - inset, &ty_in, &ty_out);
+    const double t_in = std::max(tx_in, ty_in);
+    if (!(t_in < std::min(tx_out, ty_out) && t_in > 0.0 && t_in < best->t)) return false;
+    const double x = o[0] + t_in * d[0], y = o[1] + t_in * d[1], z = o[2] + t_in * d[2];
+    const int level = code - 1;
+    // Above the top's edge there, the ray passes over the wall (and may land on the top).
+    const double edge = level_slope_[level] == 0.0 ? config_.levels[level].height
+                                                   : topHeight(level, floorDivide(i, config_.terrace_cells),
+                                                               floorDivide(j, config_.terrace_cells), x, y);
+    if (z > edge) return false;
+    best->layer = code;
+    best->t = t_in;
+    best->x = x;
+    best->y = y;
+    best->z = z;
+    best->facing = tx_in >= ty_in ? (d[0] > 0.0 ? Facing::kWest : Facing::kEast)
+                                  : (d[1] > 0.0 ? Facing::kSouth : Facing::kNorth);
+    return true;
+  };
+  if (ci == floorIndex(best->x * inverse_cell_) && cj == floorIndex(best->y * inverse_cell_)) {
+    // The most common case, cheaply: the ray stays over one cell. A ray that lands on that
+    // cell's top has not passed its walls (it crosses the top's plane once, from above).
+    if (best->layer == 0) wall(ci, cj);
+    return;
+  }
+  const int step_i = d[0] > 0.0 ? 1 : -1, step_j = d[1] > 0.0 ? 1 : -1;
+  double next_x = d[0] != 0.0 ? ((ci + (step_i > 0 ? 1 : 0)) * cell - o[0]) * inverse_x : HUGE_VAL;
+  double next_y = d[1] != 0.0 ? ((cj + (step_j > 0 ? 1 : 0)) * cell - o[1]) * inverse_y : HUGE_VAL;
+  const double delta_x = d[0] != 0.0 ? cell * std::fabs(inverse_x) : HUGE_VAL;
+  const double delta_y = d[1] != 0.0 ? cell * std::fabs(inverse_y) : HUGE_VAL;
   for (double t_cell = t_start; t_cell < best->t;) {
-    const int code = cellCode(ci, cj);
-    if (code != 0) {
-      // The prism's inset square: the ray enters it at t_in through the wall of the later slab.
-      double tx_in = 0.0, tx_out = 0.0, ty_in = 0.0, ty_out = 0.0;
-      slab(o[0], d[0], (ci + gap) * cell, (ci + 1 - gap) * cell, &tx_in, &tx_out);
-      slab(o[1], d[1], (cj + gap) * cell, (cj + 1 - gap) * cell, &ty_in, &ty_out);
-      const double t_in = std::max(tx_in, ty_in);
-      if (t_in < std::min(tx_out, ty_out) && t_in > 0.0 && t_in < best->t) {
-        const double x = o[0] + t_in * d[0], y = o[1] + t_in * d[1], z = o[2] + t_in * d[2];
-        const int level = code - 1;
-        // Above the top's edge there, the ray passes over the wall (and may land on the top).
-        if (z <= topHeight(level, floorDivide(ci, config_.terrace_cells), floorDivide(cj, config_.terrace_cells), x, y)) {
-          best->layer = code;
-          best->t = t_in;
-          best->x = x;
-          best->y = y;
-          best->z = z;
-          best->facing = tx_in >= ty_in ? (d[0] > 0.0 ? Facing::kWest : Facing::kEast)
-                                        : (d[1] > 0.0 ? Facing::kSouth : Facing::kNorth);
-          return;
-        }
-      }
-    }
+    if (wall(ci, cj)) return;
     if (next_x < next_y) {
       t_cell = next_x;
       next_x += delta_x;
