@@ -76,16 +76,17 @@ float smoothStep(double x) {
 // wrap-around so that the texture still tiles.
 void addSoftPatches(cv::Mat1f& out, cv::RNG& rng, double feature_px) {
   const int n = out.rows;
-  const int count = static_cast<int>(static_cast<double>(n) * n / (feature_px * feature_px) * 0.6) + 1;
+  const int count = static_cast<int>(static_cast<double>(n) * n / (feature_px * feature_px) * 0.35) + 1;
   for (int i = 0; i < count; ++i) {
     // One draw per statement (see addCells).
     const double centre_x = rng.uniform(0.0, static_cast<double>(n));
     const double centre_y = rng.uniform(0.0, static_cast<double>(n));
-    const double a = feature_px * rng.uniform(0.3, 1.2);
-    const double b = a * rng.uniform(0.4, 1.0);
+    const double a = feature_px * rng.uniform(0.3, 1.5);
+    const double b = a * rng.uniform(0.25, 1.0);  // round ones and long ones (fields, ponds)
     const double angle = rng.uniform(0.0, CV_PI);
-    const double value = rng.uniform(-0.9, 0.9);
-    const double edge = 0.35 * b;  // width of the soft rim [texels]
+    const double magnitude = rng.uniform(0.6, 1.3);
+    const double value = rng.uniform(0, 2) == 0 ? -magnitude : magnitude;
+    const double edge = std::max(1.5, 0.12 * b);  // width of the soft rim [texels]
     const double ca = std::cos(angle), sa = std::sin(angle);
     const int reach = static_cast<int>(std::ceil(a + edge));
     for (int dy = -reach; dy <= reach; ++dy) {
