@@ -322,9 +322,10 @@ void printPlan(const oefmt::sim::FlightPlan& plan, const Command& command) {
     std::printf("track       %s, %zu frames, %.1f m (%.3f m per frame), heading %s, yaw %.1f deg\n",
                 oefmt::sim::toString(t.shape), plan.poses.size(), t.length, oefmt::sim::frameSpacing(t),
                 t.heading == oefmt::sim::HeadingMode::kFixed ? "fixed" : "along track", t.yaw / kDeg);
-    std::printf("altitude    %.3f m%s, climb %.2f m (%s)\n", t.altitude,
+    const bool hill = oefmt::sim::resolvedClimbProfile(t) == oefmt::sim::ClimbProfile::kHill;
+    std::printf("altitude    %.3f m%s, climb %.2f m%s\n", t.altitude,
                 command.flight.track.altitude > 0.0 ? "" : " (from the target overlap)", t.climb,
-                oefmt::sim::resolvedClimbProfile(t) == oefmt::sim::ClimbProfile::kHill ? "up and back, 1 - cos" : "linear");
+                t.climb == 0.0 ? "" : hill ? " (up and back, 1 - cos)" : " (linear)");
   } else {
     std::printf("track       spin at the origin, %zu frames, yaw %.1f deg turning %.2f deg per frame\n",
                 plan.poses.size(), t.yaw / kDeg, t.spin_rate / kDeg);
