@@ -61,17 +61,19 @@ cv::Mat1f layerTexture(TextureStyle style, int size, std::uint32_t seed, double 
   }
 }
 
-// Walls are lit from the east-south-east, tops from straight above at full brightness: every
-// wall is darker than a top of its texture, and walls facing different ways differ.
-float wallShade(Facing facing) {
+// How much darker a wall is than a top of the same texture, in standard deviations of that
+// texture: walls are lit from the east-south-east, tops from straight above, so walls facing
+// different ways differ. In units of the texture's contrast so that a dull scene (--contrast)
+// gets dull walls too: fixed factors would turn its walls into its strongest edges.
+float wallDarkening(Facing facing) {
   switch (facing) {
-    case Facing::kEast: return 0.72f;
-    case Facing::kSouth: return 0.62f;
-    case Facing::kNorth: return 0.5f;
-    case Facing::kWest: return 0.42f;
+    case Facing::kEast: return 0.7f;
+    case Facing::kSouth: return 0.95f;
+    case Facing::kNorth: return 1.25f;
+    case Facing::kWest: return 1.45f;
     case Facing::kUp: break;
   }
-  return 1.0f;
+  return 0.0f;
 }
 
 }  // namespace
@@ -142,7 +144,12 @@ Scene::Scene(const SceneConfig& config)
       if (config_.texture_std > 0.0) textures_[layer] = withContrast(textures_[layer], config_.texture_std);
     }
   });
-  for (const cv::Mat1f& texture : textures_) inverse_texture_size_.emplace_back(1.0 / texture.cols, 1.0 / texture.rows);
+  for (const cv::Mat1f& texture : textures_) {
+    inverse_texture_size_.emplace_back(1.0 / texture.cols, 1.0 / texture.rows);
+    cv::Scalar mean, std;
+    cv::meanStdDev(texture, mean, std);
+    texture_std_.push_back(static_cast<float>(std[0]));
+  }
   double bound = 0.0;
   for (const BlockLevel& level : config_.levels) {
     level_reach_.push_back(config_.levelReach(level));
@@ -388,15 +395,11 @@ void Scene::castWalls(const cv::Vec3d& o, const cv::Vec3d& d, SceneHit* best) co
 }
 
 float Scene::shade(const SceneHit& hit) const {
-  switch (hit.facing) {
-    case Facing::kUp: return sample(hit.layer, hit.x, hit.y);
-    // The texture stands upright on the wall: its rows along z, its columns along the wall.
-    case Facing::kEast:
-    case Facing::kWest: return wallShade(hit.facing) * sample(hit.layer, hit.y, hit.z);
-    case Facing::kNorth:
-    case Facing::kSouth: break;
-  }
-  return wallShade(hit.facing) * sample(hit.layer, hit.x, hit.z);
+  if (!hit.onWall()) return sample(hit.layer, hit.x, hit.y);
+  // The texture stands upright on the wall: its rows along z, its columns along the wall.
+  const bool along_y = hit.facing == Facing::kEast || hit.facing == Facing::kWest;
+  const float value = sample(hit.layer, along_y ? hit.y : hit.x, hit.z);
+  return std::max(0.0f, value - wallDarkening(hit.facing) * texture_std_[hit.layer]);
 }
 
 float Scene::sample(int layer, double x, double y) const {
