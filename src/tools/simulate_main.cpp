@@ -26,9 +26,9 @@ const char* const kUsage = R"(usage: oefmt_simulate [options] OUTPUT_DIR
 
 Renders a flight of a pinhole camera looking straight down at a textured ground plane with raised
 block tops at further heights (the last level's terraces inclined; optionally solid blocks with
-walls), and writes OUTPUT_DIR in the
-o-eFMT authors' layout: Images/0001.png..., imageList.txt, timestamps.txt (seconds),
-cam_param.yaml, plus groundtruth.tum (t x y z qx qy qz qw; world x east, y north, z up).
+walls), and writes OUTPUT_DIR in the o-eFMT authors' layout: Images/0001.png..., imageList.txt,
+timestamps.txt (seconds), cam_param.yaml, plus groundtruth.tum (t x y z qx qy qz qw; world x
+east, y north, z up).
 Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames, 512x512).
 
 track:
@@ -325,7 +325,7 @@ void printPlan(const oefmt::sim::FlightPlan& plan, const Command& command) {
     const bool hill = oefmt::sim::resolvedClimbProfile(t) == oefmt::sim::ClimbProfile::kHill;
     std::printf("altitude    %.3f m%s, climb %.2f m%s\n", t.altitude,
                 command.flight.track.altitude > 0.0 ? "" : " (from the target overlap)", t.climb,
-                t.climb == 0.0 ? "" : hill ? " (up and back, 1 - cos)" : " (linear)");
+                t.climb == 0.0 ? "" : hill ? " (there and back, 1 - cos)" : " (linear)");
   } else {
     std::printf("track       spin at the origin, %zu frames, yaw %.1f deg turning %.2f deg per frame\n",
                 plan.poses.size(), t.yaw / kDeg, t.spin_rate / kDeg);
