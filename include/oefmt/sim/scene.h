@@ -128,7 +128,7 @@ class Scene {
   /// The cell code (see Layout) of the cell under world x-y, 0 in the gaps between tops; sets the
   /// cell's terrace.
   int topAt(double x, double y, long long* ti, long long* tj) const;
-  /// The cell code (see Layout) of cell (ci, cj), whether or not the point is in its gap.
+  /// The cell code (see Layout) of cell (ci, cj), gaps included.
   int cellCode(long long ci, long long cj) const;
   /// Height of a level-l top of terrace (ti, tj) at world x-y [m].
   double topHeight(int level, long long ti, long long tj, double x, double y) const;

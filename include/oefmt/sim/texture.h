@@ -18,8 +18,8 @@ enum class TextureStyle {
   kNatural, ///< photo-like: 1/f amplitude spectrum with random phases, plus soft patches
   kBrick,   ///< strictly periodic running-bond brick wall (identical bricks)
   kTiles,   ///< strictly periodic square tiles with grout lines and a motif
-  /// Not a texture: a scene's per-layer choice, kCells, kStripes, kNoise, kCells, ... for the
-  /// ground, level 1, level 2, ... (the scene's textures before styles could be chosen).
+  /// Not a texture: a scene's default per-layer choice, kCells, kStripes, kNoise, kCells, ...
+  /// for the ground, level 1, level 2, ... (each layer looks different from its neighbours).
   kMixed,
 };
 
