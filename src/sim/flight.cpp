@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include "oefmt/error.h"
@@ -49,6 +50,34 @@ double altitudeForOverlap(const CameraParameters& camera, const TrackConfig& tra
   return 0.5 * (low + high);
 }
 
+std::string metres(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f m", value);
+  return text;
+}
+
+// Raised levels must stay below the camera all along the track.
+void requireAboveTops(const FlightPlan& plan) {
+  const double top = plan.scene.highestTop();
+  double lowest = plan.poses.front().position[2];
+  for (const FlightPose& pose : plan.poses) lowest = std::min(lowest, pose.position[2]);
+  if (lowest > top) return;
+  const TrackConfig& t = plan.track;
+  std::string message = "the flight's lowest altitude (" + metres(lowest);
+  if (t.climb < 0.0) message += ", descending " + metres(-t.climb) + " from " + metres(t.altitude);
+  message += ") must be above the highest block top (" + metres(top) + "): raise the altitude, lower the levels";
+  message += t.climb < 0.0 ? " or descend less" : "";
+  throw InputError(message);
+}
+
+// splitmix64's finaliser: a well-mixed 64-bit hash, the same on every machine.
+std::uint64_t mix(std::uint64_t z) {
+  z += 0x9E3779B97F4A7C15ULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
 }  // namespace
 
 FlightPlan planFlight(const FlightOptions& o) {
@@ -56,8 +85,11 @@ FlightPlan planFlight(const FlightOptions& o) {
   plan.camera = resolveCamera(o);
   const Intrinsics& k = plan.camera.intrinsics;
   plan.track = o.track;
-  if (!(plan.track.altitude > 0.0)) {
-    plan.track.altitude = 1.0;  // validated below with the real value
+  if (!(plan.track.altitude > 0.0) && !isMoving(plan.track.shape)) {
+    plan.track.altitude = kSpinAltitude;  // a spin's frames overlap whatever its altitude
+  } else if (!(plan.track.altitude > 0.0)) {
+    // Validated here with a stand-in that survives a descent, below with the real value.
+    plan.track.altitude = 1.0 + std::max(0.0, -plan.track.climb);
     plan.track.validate();
     plan.track.altitude = altitudeForOverlap(plan.camera, plan.track, o.overlap);
   }
@@ -91,6 +123,18 @@ FlightPlan planFlight(const FlightOptions& o) {
   scene.texture_size = o.texture_size > 0 ? o.texture_size : std::min(4096, 8 * k.width);
   scene.feature_texels = std::max(2.0, scene.texture_size / 40.0);
   scene.texture_files = o.texture_files;
+  scene.texture_styles = o.texture_styles;
+  // Bricks and tiles of the same size in the image on every layer: a layer nearer the camera
+  // shows a smaller part of the world, in texels (mean_altitude - h) / fx * width / texel.
+  scene.pattern_texels.clear();
+  for (int layer = 0; layer <= static_cast<int>(scene.levels.size()); ++layer) {
+    const double h = layer == 0 ? 0.0 : scene.levels[layer - 1].height;
+    const double footprint_texels = std::max(0.0, mean_altitude - h) / k.fx * k.width / scene.texel;
+    scene.pattern_texels.push_back(std::max(1.0, footprint_texels / kPatternsPerImage));
+  }
+  if (!(o.contrast >= 0.0 && o.contrast <= 127.5)) throw InputError("contrast must be in [0, 127.5] grey levels");
+  scene.texture_std = o.contrast / 255.0;
+  scene.walls = o.walls;
   // Everything the camera sees lies inside the union of the ground footprints.
   double x_min = HUGE_VAL, y_min = HUGE_VAL, x_max = -HUGE_VAL, y_max = -HUGE_VAL;
   for (const FlightPose& pose : plan.poses) {
@@ -107,8 +151,8 @@ FlightPlan planFlight(const FlightOptions& o) {
   if (o.supersample < 1 || o.supersample > 8) throw InputError("supersample must be in [1, 8]");
   plan.supersample = o.supersample;
   if (!(o.sensor.noise >= 0.0) || !(o.sensor.brightness >= 0.0 && o.sensor.brightness < 1.0) ||
-      !(o.sensor.brightness_period > 0.0)) {
-    throw InputError("sensor: noise must be >= 0, brightness in [0, 1), brightness period > 0");
+      !(o.sensor.brightness_period > 0.0) || !(o.sensor.flicker >= 0.0 && o.sensor.flicker < 1.0)) {
+    throw InputError("sensor: noise must be >= 0, brightness and flicker in [0, 1), brightness period > 0");
   }
   plan.sensor = o.sensor;
   if (!(o.rate > 0.0) || !(o.start_time > 0.0) || !std::isfinite(o.start_time)) {
@@ -116,13 +160,7 @@ FlightPlan planFlight(const FlightOptions& o) {
   }
   for (std::size_t i = 0; i < plan.poses.size(); ++i) plan.stamps.push_back(o.start_time + i / o.rate);
 
-  const double top = scene.highestTop();
-  double lowest = plan.poses.front().position[2];
-  for (const FlightPose& pose : plan.poses) lowest = std::min(lowest, pose.position[2]);
-  if (!(lowest > top)) {
-    throw InputError("the flight's lowest altitude (" + std::to_string(lowest) +
-                     " m) must be above the highest block top (" + std::to_string(top) + " m)");
-  }
+  requireAboveTops(plan);
   plan.ground_overlap = consecutiveOverlap(plan.camera, plan.poses, 0.0);
   double highest_level = 0.0;
   for (const BlockLevel& level : scene.levels) highest_level = std::max(highest_level, level.height);
@@ -130,12 +168,20 @@ FlightPlan planFlight(const FlightOptions& o) {
   return plan;
 }
 
-double frameGain(const SensorOptions& sensor, int frame) {
-  return 1.0 + sensor.brightness * std::sin(2.0 * CV_PI * frame / sensor.brightness_period);
+double frameGain(const SensorOptions& sensor, std::uint32_t seed, int frame) {
+  double gain = 1.0 + sensor.brightness * std::sin(2.0 * CV_PI * frame / sensor.brightness_period);
+  if (sensor.flicker > 0.0) {
+    // Hashed rather than drawn from a generator seeded by the frame: consecutive seeds give
+    // correlated first draws, and the gains must be independent from frame to frame.
+    const std::uint64_t h = mix(mix(0xF11C4E5ULL ^ seed) + static_cast<std::uint64_t>(frame));
+    const double u = static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0);  // [0, 1)
+    gain *= 1.0 + sensor.flicker * (2.0 * u - 1.0);
+  }
+  return gain;
 }
 
 cv::Mat1b sensorImage(const cv::Mat1f& rendered, const SensorOptions& sensor, std::uint32_t seed, int frame) {
-  cv::Mat1f image = rendered * frameGain(sensor, frame);
+  cv::Mat1f image = rendered * frameGain(sensor, seed, frame);
   if (sensor.noise > 0.0) {
     cv::RNG rng((static_cast<std::uint64_t>(seed) << 32) ^ (0x5DEECE66DULL + static_cast<std::uint64_t>(frame)));
     cv::Mat1f noise(image.size());
@@ -158,6 +204,12 @@ void renderFlight(const FlightPlan& plan, const FrameSink& sink) {
 }
 
 std::vector<std::string> groundTruthHeader(const FlightPlan& plan) {
+  const TrackConfig& t = plan.track;
+  const std::string shape =
+      isMoving(t.shape) ? ", length " + std::to_string(t.length) + " m, altitude " + std::to_string(t.altitude) +
+                              " m, climb " + std::to_string(t.climb) + " m"
+                        : " at the origin, altitude " + std::to_string(t.altitude) + " m, yaw turning " +
+                              std::to_string(t.spin_rate * 180.0 / CV_PI) + " deg per frame";
   return {
       "oefmt_simulate ground truth, one line per frame: t x y z qx qy qz qw",
       "t: seconds (same stamps as timestamps.txt and the bag); x y z: metres",
@@ -165,9 +217,7 @@ std::vector<std::string> groundTruthHeader(const FlightPlan& plan) {
       "pose of the camera body (base_link): position and yaw about z (roll = pitch = 0)",
       "the camera looks straight down: base_link -> camera optical frame is a 180 deg turn about x",
       "(quaternion x=1 y=0 z=0 w=0), so at yaw 0 image right = +x (east), image up = +y (north)",
-      std::string("track ") + toString(plan.track.shape) + ", " + std::to_string(plan.poses.size()) +
-          " frames, length " + std::to_string(plan.track.length) + " m, altitude " +
-          std::to_string(plan.track.altitude) + " m, climb " + std::to_string(plan.track.climb) + " m",
+      std::string("track ") + toString(t.shape) + ", " + std::to_string(plan.poses.size()) + " frames" + shape,
   };
 }
 

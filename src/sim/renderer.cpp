@@ -57,9 +57,10 @@ RenderedFrame Renderer::render(const FlightPose& pose) const {
           // opticalToWorld(yaw) * (x, y, 1).
           const double x = (*ray)[0], y = (*ray)[1];
           const SceneHit hit = scene.cast(origin, cv::Vec3d(c * x + s * y, s * x - c * y, -1.0));
-          sum += scene.sample(hit.layer, hit.x, hit.y);
-          if (first_layer < 0) first_layer = hit.layer;
-          mixed = mixed || hit.layer != first_layer;
+          sum += scene.shade(hit);
+          const int code = hit.onWall() ? RenderedFrame::kWallLayers + hit.layer : hit.layer;
+          if (first_layer < 0) first_layer = code;
+          mixed = mixed || code != first_layer;
         }
         out[u] = sum / static_cast<float>(samples);
         layer_out[u] = mixed ? RenderedFrame::kMixedLayers : static_cast<unsigned char>(first_layer);

@@ -47,6 +47,35 @@ cv::Mat1f textureFromFile(const std::string& path) {
   return tile;
 }
 
+// A layer's procedural texture of a resolved style (not kMixed).
+cv::Mat1f layerTexture(TextureStyle style, int size, std::uint32_t seed, double feature_texels,
+                       double pattern_texels) {
+  switch (style) {
+    case TextureStyle::kNatural: return naturalTexture(size, seed, feature_texels);
+    case TextureStyle::kBrick: return brickTexture(size, seed, pattern_texels);
+    case TextureStyle::kTiles: return tileTexture(size, seed, pattern_texels);
+    case TextureStyle::kNoise:
+      // Plain noise is smooth at the coarse scale: finer structures keep it rich in detail.
+      return tileableTexture(size, seed, style, std::max(2.0, feature_texels / 4.0));
+    default: return tileableTexture(size, seed, style, feature_texels);
+  }
+}
+
+// How much darker a wall is than a top of the same texture, in standard deviations of that
+// texture: walls are lit from the east-south-east, tops from straight above, so walls facing
+// different ways differ. In units of the texture's contrast so that a dull scene (--contrast)
+// gets dull walls too: fixed factors would turn its walls into its strongest edges.
+float wallDarkening(Facing facing) {
+  switch (facing) {
+    case Facing::kEast: return 0.7f;
+    case Facing::kSouth: return 0.95f;
+    case Facing::kNorth: return 1.25f;
+    case Facing::kWest: return 1.45f;
+    case Facing::kUp: break;
+  }
+  return 0.0f;
+}
+
 }  // namespace
 
 void SceneConfig::validate() const {
@@ -60,6 +89,12 @@ void SceneConfig::validate() const {
   require(texel > 0.0 && std::isfinite(texel), "texel must be > 0");
   require(texture_size >= 64, "texture_size must be >= 64");
   require(feature_texels >= 2.0, "feature_texels must be >= 2");
+  for (double pattern : pattern_texels) {
+    require(pattern > 0.0 && std::isfinite(pattern), "pattern_texels must be > 0");
+  }
+  require(texture_std >= 0.0 && texture_std <= 0.5, "texture_std must be in [0, 0.5]");
+  // The renderer's layer map codes level k as k and its walls as 128 + k.
+  require(levels.size() <= 126, "at most 126 raised levels");
   double shares = 0.0;
   for (const BlockLevel& level : levels) {
     require(level.height > 0.0 && std::isfinite(level.height), "level heights must be > 0");
@@ -81,6 +116,11 @@ double SceneConfig::highestTop() const {
   return top;
 }
 
+double SceneConfig::patternTexels(int layer) const {
+  if (pattern_texels.empty()) return 64.0;
+  return pattern_texels[std::min(static_cast<std::size_t>(layer), pattern_texels.size() - 1)];
+}
+
 Scene::Scene(const SceneConfig& config)
     : config_(config), seed_hash_(mix(config.seed)) {
   config_.validate();
@@ -88,7 +128,7 @@ Scene::Scene(const SceneConfig& config)
   inverse_cell_ = 1.0 / config_.cell_size;
   inverse_terrace_side_ = 1.0 / terrace_side_;
   inverse_texel_ = 1.0 / config_.texel;
-  const TextureStyle styles[] = {TextureStyle::kCells, TextureStyle::kStripes, TextureStyle::kNoise};
+  highest_top_ = config_.highestTop();
   const int layers = static_cast<int>(config_.levels.size()) + 1;
   textures_.resize(layers);
   // Layers in parallel: the textures are the slowest part of setting up a flight.
@@ -97,15 +137,19 @@ Scene::Scene(const SceneConfig& config)
       const bool from_file = layer < static_cast<int>(config_.texture_files.size()) &&
                              !config_.texture_files[layer].empty();
       const int size = layer == 0 ? config_.texture_size : std::max(64, config_.texture_size / 2);
-      const TextureStyle style = styles[layer % 3];
-      // Plain noise is smooth at the coarse scale: finer structures keep it rich in detail.
-      const double feature = style == TextureStyle::kNoise ? std::max(2.0, config_.feature_texels / 4.0)
-                                                            : config_.feature_texels;
       textures_[layer] = from_file ? textureFromFile(config_.texture_files[layer])
-                                   : tileableTexture(size, config_.seed * 7919u + layer, style, feature);
+                                   : layerTexture(layerTextureStyle(config_.texture_styles, layer), size,
+                                                  config_.seed * 7919u + layer, config_.feature_texels,
+                                                  config_.patternTexels(layer));
+      if (config_.texture_std > 0.0) textures_[layer] = withContrast(textures_[layer], config_.texture_std);
     }
   });
-  for (const cv::Mat1f& texture : textures_) inverse_texture_size_.emplace_back(1.0 / texture.cols, 1.0 / texture.rows);
+  for (const cv::Mat1f& texture : textures_) {
+    inverse_texture_size_.emplace_back(1.0 / texture.cols, 1.0 / texture.rows);
+    cv::Scalar mean, std;
+    cv::meanStdDev(texture, mean, std);
+    texture_std_.push_back(static_cast<float>(std[0]));
+  }
   double bound = 0.0;
   for (const BlockLevel& level : config_.levels) {
     level_reach_.push_back(config_.levelReach(level));
@@ -185,6 +229,15 @@ cv::Vec2d Scene::terraceSlope(long long ti, long long tj, int level) const {
   return level_slope_[level] * directions_[direction];
 }
 
+// Inline: the wall walk calls it for every cell it crosses.
+inline int Scene::cellCode(long long ci, long long cj) const {
+  const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
+  if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
+    return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
+  }
+  return computeCellCode(ci, cj);
+}
+
 int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
   const double cx = x * inverse_cell_, cy = y * inverse_cell_;
   const double fci = std::floor(cx), fcj = std::floor(cy);
@@ -193,11 +246,13 @@ int Scene::topAt(double x, double y, long long* ti, long long* tj) const {
   const long long ci = static_cast<long long>(fci), cj = static_cast<long long>(fcj);
   *ti = floorDivide(ci, config_.terrace_cells);
   *tj = floorDivide(cj, config_.terrace_cells);
-  const long long i = ci - layout_.cell_i0, j = cj - layout_.cell_j0;
-  if (i >= 0 && j >= 0 && i < layout_.cell_cols && j < layout_.cell_rows) {
-    return layout_.cell_code[static_cast<std::size_t>(j) * layout_.cell_cols + i];
-  }
-  return computeCellCode(ci, cj);
+  return cellCode(ci, cj);
+}
+
+double Scene::topHeight(int level, long long ti, long long tj, double x, double y) const {
+  const cv::Vec2d slope = terraceSlope(ti, tj, level);
+  return config_.levels[level].height + slope[0] * (x - (ti + 0.5) * terrace_side_) +
+         slope[1] * (y - (tj + 0.5) * terrace_side_);
 }
 
 int Scene::layerAt(double x, double y, double* height) const {
@@ -205,12 +260,7 @@ int Scene::layerAt(double x, double y, double* height) const {
   const int code = topAt(x, y, &ti, &tj);
   if (height) *height = 0.0;
   if (code == 0) return 0;
-  const int level = code - 1;
-  if (height) {
-    const cv::Vec2d slope = terraceSlope(ti, tj, level);
-    *height = config_.levels[level].height + slope[0] * (x - (ti + 0.5) * terrace_side_) +
-              slope[1] * (y - (tj + 0.5) * terrace_side_);
-  }
+  if (height) *height = topHeight(code - 1, ti, tj, x, y);
   return code;
 }
 
@@ -262,7 +312,94 @@ SceneHit Scene::cast(const cv::Vec3d& o, const cv::Vec3d& d) const {
     }
   }
   best.z = o[2] + best.t * d[2];
+  if (config_.walls && !config_.levels.empty()) castWalls(o, d, &best);
   return best;
+}
+
+void Scene::castWalls(const cv::Vec3d& o, const cv::Vec3d& d, SceneHit* best) const {
+  // Nothing stands above the highest top: walk the cells under the ray from where it descends
+  // through that height to its hit so far (a top or the ground), nearest first, so the first
+  // wall met is the nearest one.
+  const double t_start = std::max(0.0, (o[2] - highest_top_) / -d[2]);
+  if (!(t_start < best->t)) return;
+  const double cell = config_.cell_size;
+  long long ci = floorIndex((o[0] + t_start * d[0]) * inverse_cell_);
+  long long cj = floorIndex((o[1] + t_start * d[1]) * inverse_cell_);
+  // Reciprocals: the walk multiplies instead of dividing (an axis the ray does not move along
+  // never reaches a boundary).
+  const double inverse_x = d[0] != 0.0 ? 1.0 / d[0] : 0.0, inverse_y = d[1] != 0.0 ? 1.0 / d[1] : 0.0;
+  // The ray's parameter range inside [low, high] along one axis (all of it, or none, for an
+  // axis it does not move along).
+  const auto slab = [](double origin, double direction, double inverse, double low, double high, double* in,
+                       double* out) {
+    if (direction == 0.0) {
+      *in = origin >= low && origin <= high ? -HUGE_VAL : HUGE_VAL;
+      *out = HUGE_VAL;
+      return;
+    }
+    const double a = (low - origin) * inverse, b = (high - origin) * inverse;
+    *in = std::min(a, b);
+    *out = std::max(a, b);
+  };
+  const double inset = config_.gap * cell;
+  // Whether the ray enters the block of cell (ci, cj) through a side wall before *best; if so
+  // *best becomes that wall.
+  const auto wall = [&](long long i, long long j) {
+    const int code = cellCode(i, j);
+    if (code == 0) return false;
+    // The block's inset square: the ray enters it at t_in through the wall of the later slab.
+    double tx_in = 0.0, tx_out = 0.0, ty_in = 0.0, ty_out = 0.0;
+    slab(o[0], d[0], inverse_x, i * cell + inset, (i + 1) * cell - inset, &tx_in, &tx_out);
+    slab(o[1], d[1], inverse_y, j * cell + inset, (j + 1) * cell - inset, &ty_in, &ty_out);
+    const double t_in = std::max(tx_in, ty_in);
+    if (!(t_in < std::min(tx_out, ty_out) && t_in > 0.0 && t_in < best->t)) return false;
+    const double x = o[0] + t_in * d[0], y = o[1] + t_in * d[1], z = o[2] + t_in * d[2];
+    const int level = code - 1;
+    // Above the top's edge there, the ray passes over the wall (and may land on the top).
+    const double edge = level_slope_[level] == 0.0 ? config_.levels[level].height
+                                                   : topHeight(level, floorDivide(i, config_.terrace_cells),
+                                                               floorDivide(j, config_.terrace_cells), x, y);
+    if (z > edge) return false;
+    best->layer = code;
+    best->t = t_in;
+    best->x = x;
+    best->y = y;
+    best->z = z;
+    best->facing = tx_in >= ty_in ? (d[0] > 0.0 ? Facing::kWest : Facing::kEast)
+                                  : (d[1] > 0.0 ? Facing::kSouth : Facing::kNorth);
+    return true;
+  };
+  if (ci == floorIndex(best->x * inverse_cell_) && cj == floorIndex(best->y * inverse_cell_)) {
+    // The most common case, cheaply: the ray stays over one cell. A ray that lands on that
+    // cell's top has not passed its walls (it crosses the top's plane once, from above).
+    if (best->layer == 0) wall(ci, cj);
+    return;
+  }
+  const int step_i = d[0] > 0.0 ? 1 : -1, step_j = d[1] > 0.0 ? 1 : -1;
+  double next_x = d[0] != 0.0 ? ((ci + (step_i > 0 ? 1 : 0)) * cell - o[0]) * inverse_x : HUGE_VAL;
+  double next_y = d[1] != 0.0 ? ((cj + (step_j > 0 ? 1 : 0)) * cell - o[1]) * inverse_y : HUGE_VAL;
+  const double delta_x = d[0] != 0.0 ? cell * std::fabs(inverse_x) : HUGE_VAL;
+  const double delta_y = d[1] != 0.0 ? cell * std::fabs(inverse_y) : HUGE_VAL;
+  for (double t_cell = t_start; t_cell < best->t;) {
+    if (wall(ci, cj)) return;
+    if (next_x < next_y) {
+      t_cell = next_x;
+      next_x += delta_x;
+      ci += step_i;
+    } else {
+      t_cell = next_y;
+      next_y += delta_y;
+      cj += step_j;
+    }
+  }
+}
+
+float Scene::shade(const SceneHit& hit) const {
+  if (!hit.onWall()) return sample(hit.layer, hit.x, hit.y);
+  // The texture stands upright on the wall: its rows along z, its columns along the wall.
+  const bool along_y = hit.facing == Facing::kEast || hit.facing == Facing::kWest;
+  const float value = sample(hit.layer, along_y ? hit.y : hit.x, hit.z);
+  return std::max(0.0f, value - wallDarkening(hit.facing) * texture_std_[hit.layer]);
 }
 
 float Scene::sample(int layer, double x, double y) const {

@@ -16,7 +16,8 @@ cv::Point2d unitShape(const TrackConfig& config, double u) {
   switch (config.shape) {
     case TrackShape::kCircle: return {std::cos(a), std::sin(a)};
     case TrackShape::kEight: return {std::sin(a), std::sin(a) * std::cos(a)};
-    case TrackShape::kLine: break;
+    case TrackShape::kLine:
+    case TrackShape::kSpin: break;
   }
   return {u * std::cos(config.line_direction), u * std::sin(config.line_direction)};
 }
@@ -27,7 +28,8 @@ double unitSpeed(const TrackConfig& config, double u) {
   switch (config.shape) {
     case TrackShape::kCircle: return 2.0 * CV_PI;
     case TrackShape::kEight: return 2.0 * CV_PI * std::hypot(std::cos(a), std::cos(2.0 * a));
-    case TrackShape::kLine: break;
+    case TrackShape::kLine:
+    case TrackShape::kSpin: break;
   }
   return 1.0;
 }
@@ -63,25 +65,54 @@ struct ArcTable {
   }
 };
 
+// A spin: the camera stays at the origin and turns.
+std::vector<FlightPose> makeSpin(const TrackConfig& config) {
+  std::vector<FlightPose> poses(config.frames);
+  for (int k = 0; k < config.frames; ++k) {
+    poses[k].position = cv::Vec3d(0.0, 0.0, config.altitude);
+    poses[k].yaw = std::remainder(config.yaw + k * config.spin_rate, 2.0 * CV_PI);
+  }
+  return poses;
+}
+
 }  // namespace
 
 void TrackConfig::validate() const {
   auto require = [](bool ok, const std::string& what) {
     if (!ok) throw InputError("track: " + what);
   };
-  require(length > 0.0 && std::isfinite(length), "length must be > 0");
+  if (isMoving(shape)) {
+    require(length > 0.0 && std::isfinite(length), "length must be > 0");
+  } else {
+    require(climb == 0.0, "a spin does not climb (climb must be 0)");
+    require(heading == HeadingMode::kFixed, "a spin does not move: its heading cannot follow the track");
+  }
   require(frames >= 2, "frames must be >= 2");
   require(altitude > 0.0 && std::isfinite(altitude), "altitude must be > 0");
   require(std::isfinite(climb) && altitude + climb > 0.0, "altitude + climb must stay > 0");
+  require(!(climb_profile == ClimbProfile::kRamp && isClosed(shape)),
+          "a loop must come back to its start: climb profile ramp needs a line track");
   require(std::isfinite(yaw) && std::isfinite(line_direction), "angles must be finite");
+  require(std::isfinite(spin_rate) && std::fabs(spin_rate) < CV_PI, "spin rate must be in (-180, 180) deg");
 }
 
-bool isClosed(TrackShape shape) { return shape != TrackShape::kLine; }
+bool isClosed(TrackShape shape) { return shape == TrackShape::kCircle || shape == TrackShape::kEight; }
 
-double frameSpacing(const TrackConfig& config) { return config.length / (config.frames - 1); }
+bool isMoving(TrackShape shape) { return shape != TrackShape::kSpin; }
+
+ClimbProfile resolvedClimbProfile(const TrackConfig& config) {
+  if (config.climb_profile != ClimbProfile::kAuto) return config.climb_profile;
+  return isClosed(config.shape) ? ClimbProfile::kHill : ClimbProfile::kRamp;
+}
+
+double frameSpacing(const TrackConfig& config) {
+  return isMoving(config.shape) ? config.length / (config.frames - 1) : 0.0;
+}
 
 std::vector<FlightPose> makeTrack(const TrackConfig& config) {
   config.validate();
+  if (!isMoving(config.shape)) return makeSpin(config);
+  const bool hill = resolvedClimbProfile(config) == ClimbProfile::kHill;
   const ArcTable table(config);
   const double scale = config.length / table.total();
   const double step = frameSpacing(config);
@@ -92,7 +123,7 @@ std::vector<FlightPose> makeTrack(const TrackConfig& config) {
     const double u = table.at(s / scale);
     FlightPose pose;
     const cv::Point2d p = unitShape(config, u) * scale;
-    const double profile = isClosed(config.shape) ? 0.5 * (1.0 - std::cos(2.0 * CV_PI * fraction)) : fraction;
+    const double profile = hill ? 0.5 * (1.0 - std::cos(2.0 * CV_PI * fraction)) : fraction;
     pose.position = cv::Vec3d(p.x, p.y, config.altitude + config.climb * profile);
     pose.yaw = config.yaw;
     if (config.heading == HeadingMode::kTrack) {
@@ -115,7 +146,8 @@ TrackShape trackShapeFromString(const std::string& name) {
   if (name == "circle") return TrackShape::kCircle;
   if (name == "eight") return TrackShape::kEight;
   if (name == "line") return TrackShape::kLine;
-  throw InputError("unknown track '" + name + "' (expected circle, eight or line)");
+  if (name == "spin") return TrackShape::kSpin;
+  throw InputError("unknown track '" + name + "' (expected circle, eight, line or spin)");
 }
 
 const char* toString(TrackShape shape) {
@@ -123,6 +155,7 @@ const char* toString(TrackShape shape) {
     case TrackShape::kCircle: return "circle";
     case TrackShape::kEight: return "eight";
     case TrackShape::kLine: return "line";
+    case TrackShape::kSpin: return "spin";
   }
   return "?";
 }

@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -76,6 +77,48 @@ TEST(Tools, SimulateConvertAndEvaluate) {
   ASSERT_EQ(evaluate.status, 0) << evaluate.err;
   EXPECT_EQ(evaluate.out.rfind("{\"estimate_poses\":6,", 0), 0u) << evaluate.out;
   EXPECT_NE(evaluate.out.find("\"rmse\":0"), std::string::npos) << evaluate.out;
+}
+
+// The corpus options: a small flight with every one of them, a spin, and their one-line errors.
+TEST(Tools, SimulateCorpusOptions) {
+  TempDir dir;
+  const std::string simulate = std::string(OEFMT_SIMULATE) + " --size 96 --frames 3 ";
+  ToolRun result = run(dir, simulate + "--length 6 --texture-style natural,brick,tiles --contrast 10 --noise-grey 5 "
+                                      "--flicker 0.1 --walls --climb -1 --climb-profile hill --track line " +
+                                (dir / "varied"));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("ground natural, 1 brick "), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("rescaled to grey std 10.0"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("walls"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("grey std    of the written frames: mean "), std::string::npos) << result.out;
+  EXPECT_EQ(FolderDataset(dir / "varied").size(), 3u);
+
+  result = run(dir, simulate + "--track spin --spin-rate -10 " + (dir / "spin"));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("spin at the origin, 3 frames, yaw 0.0 deg turning -10.00 deg per frame"),
+            std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("altitude    20.000 m"), std::string::npos) << result.out;
+
+  const std::pair<std::string, std::string> bad[] = {
+      {"--track spin --overlap 0.8", "--overlap does not apply to --track spin"},
+      {"--track spin --length 10", "--length does not apply to --track spin"},
+      {"--track spin --climb 2", "--climb does not apply to --track spin"},
+      {"--spin-rate 5", "--spin-rate applies to --track spin only"},
+      {"--track spin --spin-rate 200", "--spin-rate must be in (-180, 180) deg"},
+      {"--climb-profile ramp", "--climb-profile ramp needs --track line"},
+      {"--climb-profile up", "--climb-profile must be ramp or hill"},
+      {"--texture-style cells,marble", "--texture-style: unknown texture style 'marble'"},
+      {"--contrast 0", "--contrast must be in (0, 127.5]"},
+      {"--flicker 1", "--flicker must be in [0, 1)"},
+      {"--noise-grey -1", "--noise-grey must be >= 0"},
+      {"--track line --altitude 10 --climb -8", "descend less"},
+  };
+  for (const auto& [options, message] : bad) {
+    result = run(dir, simulate + options + " " + (dir / "bad"));
+    EXPECT_EQ(result.status, 2) << options;
+    EXPECT_NE(result.err.find(message), std::string::npos) << options << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  }
 }
 
 TEST(Tools, ExitCodesAndMessages) {

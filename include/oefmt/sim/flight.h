@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // A whole simulated flight: options with automatic defaults resolved into a plan (camera, track,
-// scene, stamps), rendering of every frame and the simulated sensor (noise, brightness).
+// scene, stamps), rendering of every frame and the simulated sensor (noise, brightness, flicker).
 #pragma once
 
 #include <cstdint>
@@ -23,12 +23,16 @@ struct SensorOptions {
   double noise = 0.0;              ///< std of additive Gaussian noise, intensity units (1 = white)
   double brightness = 0.0;         ///< relative amplitude of the frame gain's variation
   double brightness_period = 50.0; ///< frames per period of the gain's sine
+  /// Random per-frame gain factor, uniform in [1 - flicker, 1 + flicker] (deterministic for seed
+  /// and frame), times the sine's gain.
+  double flicker = 0.0;
 };
 
 /// Every option of a flight. Zero (or empty) means "choose automatically", as documented.
 struct FlightOptions {
   FlightOptions() { track.altitude = 0.0; }
-  TrackConfig track;          ///< track.altitude 0 (default): chosen so frames overlap `overlap`
+  /// track.altitude 0 (default): chosen so frames overlap `overlap`; a spin's: kSpinAltitude.
+  TrackConfig track;
   double overlap = 0.78;      ///< target mean overlap of consecutive frames on the ground
   int width = 512;            ///< image size [px]
   int height = 512;
@@ -48,11 +52,22 @@ struct FlightOptions {
   double texel = 0.0;         ///< texture resolution [m]; 0: half a ground pixel at mean altitude
   int texture_size = 0;       ///< procedural texture side [texels]; 0: 8 * width, at most 4096
   std::vector<std::string> texture_files;  ///< per layer (0 ground, 1.. levels), empty = procedural
+  /// Procedural style per layer (ground first; beyond the list the last one); empty: kMixed.
+  std::vector<TextureStyle> texture_styles;
+  double contrast = 0.0;      ///< grey std [grey levels of 255] of every texture; 0: as made
+  bool walls = false;         ///< tops are lids of solid prisms whose side walls are rendered
   int supersample = 2;        ///< s x s rays per pixel
   SensorOptions sensor;
   double rate = 5.0;          ///< frames per second [Hz]
   double start_time = 1.0;    ///< stamp of the first frame [s] (> 0: ROS bags need it)
 };
+
+/// Altitude of a spin without a given altitude [m] (a spin has no overlap to choose it by).
+constexpr double kSpinAltitude = 20.0;
+
+/// Bricks or tiles per image width (on their layer, at the mean altitude): many repetitions, so
+/// that phase correlation sees a strictly periodic pattern.
+constexpr double kPatternsPerImage = 16.0;
 
 /// The resolved flight.
 struct FlightPlan {
@@ -71,8 +86,8 @@ struct FlightPlan {
 /// Throws InputError naming the first invalid option.
 FlightPlan planFlight(const FlightOptions& options);
 
-/// The camera's gain for frame k (1 without brightness change).
-double frameGain(const SensorOptions& sensor, int frame);
+/// The camera's gain for frame k (1 without brightness change or flicker).
+double frameGain(const SensorOptions& sensor, std::uint32_t seed, int frame);
 
 /// Applies gain and noise (deterministic for seed and frame) and converts to 8 bits.
 cv::Mat1b sensorImage(const cv::Mat1f& rendered, const SensorOptions& sensor, std::uint32_t seed, int frame);

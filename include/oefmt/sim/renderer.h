@@ -18,9 +18,11 @@ namespace sim {
 /// A rendered frame.
 struct RenderedFrame {
   cv::Mat1f image;  ///< intensities in [0, 1]
-  /// Layer seen by each pixel: 0 ground, k raised level k; kMixedLayers where the pixel's samples
-  /// saw different layers (an edge of a top).
+  /// Surface seen by each pixel: 0 ground, k a top of raised level k, kWallLayers + k a side wall
+  /// of a level-k top (scenes with walls only); kMixedLayers where the pixel's samples saw
+  /// different ones (an edge of a top or wall).
   cv::Mat1b layers;
+  static constexpr unsigned char kWallLayers = 128;
   static constexpr unsigned char kMixedLayers = 255;
 };
 

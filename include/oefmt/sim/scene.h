@@ -6,7 +6,9 @@
 // by a hash of the seed, weighted by the levels' shares); in a raised terrace each cell carries a
 // block top with probability `fill`, inset by `gap` of the cell on every side so that gaps show
 // the deeper layers. An inclined level tilts each terrace's tops as one plane through the level's
-// height at the terrace centre, downhill in a random direction per terrace. Tops have no walls.
+// height at the terrace centre, downhill in a random direction per terrace. Without `walls` tops
+// are zero-thickness slabs; with it each top is the lid of a solid prism standing on the ground,
+// whose four vertical side walls are surfaces too.
 #pragma once
 
 #include <cstdint>
@@ -15,6 +17,8 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "oefmt/sim/texture.h"
 
 namespace oefmt {
 namespace sim {
@@ -39,6 +43,16 @@ struct SceneConfig {
   double feature_texels = 100.0;  ///< coarsest procedural structures [texels]
   /// Image file per layer (0 = ground, k = levels[k - 1]); empty or missing = procedural.
   std::vector<std::string> texture_files;
+  /// Procedural style per layer (ground first); beyond the list the last one; empty = kMixed.
+  std::vector<TextureStyle> texture_styles;
+  /// Brick length / tile side per layer [texels] (ground first; beyond the list the last one;
+  /// empty: 64), for the brick and tiles styles.
+  std::vector<double> pattern_texels;
+  /// Standard deviation every layer's texture is rescaled to (intensity units, around mid grey
+  /// 0.5, clipped to [0, 1]); 0 = as made.
+  double texture_std = 0.0;
+  /// Tops are lids of solid prisms standing on the ground; their side walls are rendered.
+  bool walls = false;
   /// World x-y area [m] whose block layout is tabulated for speed; outside it the same layout is
   /// computed on the fly (the images do not depend on it). Empty: nothing tabulated.
   cv::Rect2d region;
@@ -49,7 +63,13 @@ struct SceneConfig {
   double levelReach(const BlockLevel& level) const;
   /// Height of the highest point of any top [m] (0 without raised levels).
   double highestTop() const;
+  /// pattern_texels of a layer (see there).
+  double patternTexels(int layer) const;
 };
+
+/// Which way the surface a ray hits faces: up (a top or the ground) or one of the four
+/// directions of a prism's side walls (world axes: east = +x, north = +y).
+enum class Facing : unsigned char { kUp, kEast, kWest, kNorth, kSouth };
 
 /// Where a ray meets the scene.
 struct SceneHit {
@@ -58,6 +78,8 @@ struct SceneHit {
   double x = 0.0;    ///< world position of the hit [m]
   double y = 0.0;
   double z = 0.0;
+  Facing facing = Facing::kUp;  ///< anything but kUp: a side wall of a top of `layer`
+  bool onWall() const { return facing != Facing::kUp; }
 };
 
 class Scene {
@@ -75,6 +97,11 @@ class Scene {
 
   /// Bilinear texture value of `layer` at world x-y (textures repeat).
   float sample(int layer, double x, double y) const;
+
+  /// The intensity a hit shows: on a top or the ground its layer's texture at x-y; on a wall the
+  /// layer's texture at (horizontal position along the wall, z), darkened by 0.7 (facing east),
+  /// 0.95 (south), 1.25 (north) or 1.45 (west) times the texture's standard deviation, at least 0.
+  float shade(const SceneHit& hit) const;
 
   /// The raised level (1-based layer) whose top covers world x-y, or 0 for bare ground; with
   /// the top's height in *height (0 for the ground).
@@ -101,6 +128,12 @@ class Scene {
   /// The cell code (see Layout) of the cell under world x-y, 0 in the gaps between tops; sets the
   /// cell's terrace.
   int topAt(double x, double y, long long* ti, long long* tj) const;
+  /// The cell code (see Layout) of cell (ci, cj), gaps included.
+  int cellCode(long long ci, long long cj) const;
+  /// Height of a level-l top of terrace (ti, tj) at world x-y [m].
+  double topHeight(int level, long long ti, long long tj, double x, double y) const;
+  /// Replaces *best by the first prism side wall along the ray before it, if any.
+  void castWalls(const cv::Vec3d& origin, const cv::Vec3d& direction, SceneHit* best) const;
   void tabulate();
 
   SceneConfig config_;
@@ -112,6 +145,8 @@ class Scene {
   double inverse_texel_;
   std::vector<cv::Vec2d> inverse_texture_size_;  ///< per layer (1 / cols, 1 / rows)
   std::vector<cv::Mat1f> textures_;
+  std::vector<float> texture_std_;    ///< per layer: its texture's standard deviation
+  double highest_top_;
   std::vector<double> level_reach_;   ///< largest |top height - level height| per level [m]
   std::vector<double> level_slope_;   ///< tan(incline) per level
   std::vector<double> share_bounds_;  ///< cumulative shares: terrace hash below bound l -> level l

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Flight tracks flown at constant speed: circle, figure-8 and straight line.
+// Flight tracks flown at constant speed: circle, figure-8 and straight line; and a turn on the
+// spot.
 #pragma once
 
 #include <string>
@@ -14,6 +15,14 @@ enum class TrackShape {
   kCircle,  ///< counter-clockwise, centred on the origin, starting at (R, 0)
   kEight,   ///< figure-8 (lemniscate of Gerono) through the origin, lobes along x
   kLine,    ///< straight, from the origin along `line_direction`
+  kSpin,    ///< no motion: at the origin, the yaw turning by `spin_rate` per frame
+};
+
+/// How the altitude changes by `climb` along a track.
+enum class ClimbProfile {
+  kAuto,  ///< kRamp for a line, kHill for loops (which must come back)
+  kRamp,  ///< linearly from altitude to altitude + climb (lines only)
+  kHill,  ///< smoothly (1 - cos) to altitude + climb half-way and back to altitude
 };
 
 enum class HeadingMode {
@@ -23,15 +32,18 @@ enum class HeadingMode {
 
 struct TrackConfig {
   TrackShape shape = TrackShape::kCircle;
-  double length = 491.0;      ///< path length from the first to the last frame [m]
+  double length = 491.0;      ///< path length from the first to the last frame [m] (not kSpin)
   int frames = 200;
   double altitude = 10.0;     ///< height above the ground at the start [m]
-  /// Altitude change [m]: a line climbs linearly to altitude + climb; closed tracks climb to it
-  /// half-way (smoothly, 1 - cos) and come back, so the loop still closes.
+  /// Altitude change [m] (negative: a descent), shaped by climb_profile: by default a line climbs
+  /// linearly to altitude + climb; closed tracks climb to it half-way (smoothly, 1 - cos) and come
+  /// back, so the loop still closes. A spin has none.
   double climb = 0.0;
-  HeadingMode heading = HeadingMode::kFixed;
-  double yaw = 0.0;             ///< [rad]
+  ClimbProfile climb_profile = ClimbProfile::kAuto;
+  HeadingMode heading = HeadingMode::kFixed;  ///< kTrack needs a moving track (not kSpin)
+  double yaw = 0.0;             ///< [rad]; a spin's yaw at the first frame
   double line_direction = 0.0;  ///< direction of a line track [rad] from +x, counter-clockwise
+  double spin_rate = 6.0 * CV_PI / 180.0;  ///< yaw change per frame of a spin [rad], either sign
 
   /// Throws InputError naming the first invalid field.
   void validate() const;
@@ -41,13 +53,19 @@ struct TrackConfig {
 /// as in the authors' datasets (N frames, N - 1 equal steps around the loop).
 bool isClosed(TrackShape shape);
 
-/// Distance between consecutive frames [m].
+/// True for tracks along which the camera moves (all but kSpin).
+bool isMoving(TrackShape shape);
+
+/// The climb profile that applies (kAuto resolved).
+ClimbProfile resolvedClimbProfile(const TrackConfig& config);
+
+/// Distance between consecutive frames [m] (0 for a spin).
 double frameSpacing(const TrackConfig& config);
 
 /// The camera pose of every frame, at equal distances along the track.
 std::vector<FlightPose> makeTrack(const TrackConfig& config);
 
-/// "circle", "eight", "line" -> shape; throws InputError otherwise.
+/// "circle", "eight", "line", "spin" -> shape; throws InputError otherwise.
 TrackShape trackShapeFromString(const std::string& name);
 const char* toString(TrackShape shape);
 
