@@ -25,6 +25,9 @@ struct RegistrationConfig {
   /// (0 = always warp) [px].
   double identity_warp_px = 0.1;
   FftPlanning fft_planning = FftPlanning::kPatient;  ///< FFTW planning effort (once per size and machine)
+  /// Weight each frequency of the translation correlation by its share of signal (sensor noise
+  /// estimated from the spectrum's outer ring, see noisePower).
+  bool noise_weighting = true;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

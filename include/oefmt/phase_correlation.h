@@ -19,8 +19,12 @@ void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Ma
 /// The same cross power, modulated so that its inverse FFT (Fft2d::inverse) is directly the
 /// centred surface fftshift(correlation) / N^2, where a shift t peaks at (N/2, N/2) + t:
 /// fftshift and 1/N^2 are folded into the spectrum as (-1)^(fx + fy) / N^2 (no extra pass).
+/// With noise powers (a spectrum's expected |.|^2 of pure noise, see noisePower), each frequency
+/// is weighted by its share of signal in both spectra, max(0, 1 - noise / |.|^2) each: frequencies
+/// where sensor noise dominates would otherwise count as much as the texture's and bury the peak.
 void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
-                       bool half_turn = false, SimdKernel kernel = SimdKernel::kAuto);
+                       bool half_turn = false, SimdKernel kernel = SimdKernel::kAuto,
+                       float newer_noise = 0.0f, float older_noise = 0.0f);
 
 /// Height of the phase-correlation peak computed from the lowest frequencies only (an M x M
 /// correlation with M = small.size()): a cheap test of which of two hypotheses matches.

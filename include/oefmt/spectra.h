@@ -70,6 +70,7 @@ struct FrameSpectra {
   double texture = 0.0;         ///< grey standard deviation
   float mean = 0.0f;            ///< grey mean, subtracted before apodization
   int invalid_pixels = 0;       ///< non-finite input pixels that were replaced
+  float noise_power = 0.0f;     ///< noisePower(spectrum) (0 without noise weighting)
 
   bool empty() const { return grey.empty(); }
 };
@@ -101,5 +102,13 @@ std::string fftPlanningNotice(const RegistrationConfig& config);
 /// the columns the real FFT omits by Hermitian symmetry. `filter` holds (at least) those rows.
 void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::Mat1f& magnitude,
                         SimdKernel kernel = SimdKernel::kAuto);
+
+/// The expected |.|^2 of a frequency of a real N x N spectrum (the real FFT's N x (N/2 + 1)
+/// layout) that holds only white sensor noise: from the frequencies beyond 0.4 N of the centre,
+/// where a scene's texture has the least power, as the ring's lower quartile over its value for
+/// pure noise (|.|^2 of white noise is exponentially distributed: the quartile is ln(4/3) times
+/// the mean). A scene with fine texture there raises it, which weights those frequencies down
+/// a little; a blurred or upscaled frame gives about 0.
+float noisePower(const cv::Mat2f& spectrum);
 
 }  // namespace oefmt

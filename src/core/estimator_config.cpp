@@ -135,6 +135,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   number("min_texture", r.min_texture), number("min_confidence", r.min_confidence),
                   integer("rotation_zoom_candidates", r.rotation_zoom_candidates),
                   number("identity_warp_px", r.identity_warp_px),
+                  boolean("noise_weighting", r.noise_weighting),
                   {"fft_planning",
                    [&r](const YamlNode& n, const std::string& k) {
                      const std::string v = readString(n, k);

@@ -168,6 +168,20 @@ Similarity alignTrajectories(const std::vector<Eigen::Vector3d>& source,
     dst.col(k) = target[k].head(dims);
   }
   const double spread = (src.colwise() - src.rowwise().mean()).squaredNorm();
+  if (!(spread > 1e-18) && !with_scale) {
+    // Nothing to turn (a camera that never moved): the rigid fit is a shift of the means.
+    Similarity s;
+    s.translation.head(dims) = dst.rowwise().mean() - src.rowwise().mean();
+    if (planar) {
+      double source_z = 0.0, target_z = 0.0;
+      for (int k = 0; k < n; ++k) {
+        source_z += source[k].z();
+        target_z += target[k].z();
+      }
+      s.translation.z() = (target_z - source_z) / n;
+    }
+    return s;
+  }
   if (!(spread > 1e-18)) throw InputError("alignment: the estimated positions all coincide");
   const Eigen::MatrixXd transform = Eigen::umeyama(src, dst, with_scale);
   Similarity s;

@@ -25,9 +25,31 @@ int wrap(int i, int n) { return ((i % n) + n) % n; }
 // `factor` * (-1)^i when `alternate`; the loop has no branch and no call, so the compiler
 // vectorises it (the AVX2 kernel computes the same).
 void crossPowerRun(const float* p, const float* q, float* out, int count, float conjugate_sign,
-                   float factor, bool alternate, SimdKernel kernel) {
+                   float factor, bool alternate, SimdKernel kernel, float p_noise = 0.0f,
+                   float q_noise = 0.0f) {
+  const bool weighted = p_noise > 0.0f || q_noise > 0.0f;
   if (detail::runsAvx2(kernel)) {
-    detail::crossPowerRowAvx2(p, q, out, count, conjugate_sign, factor, alternate);
+    if (weighted) {
+      detail::crossPowerRowWeightedAvx2(p, q, out, count, conjugate_sign, factor, alternate,
+                                        p_noise, q_noise);
+    } else {
+      detail::crossPowerRowAvx2(p, q, out, count, conjugate_sign, factor, alternate);
+    }
+    return;
+  }
+  if (weighted) {
+    const float odd_factor = alternate ? -factor : factor;
+    for (int i = 0; i < count; ++i) {
+      const float pr = p[2 * i], pi = p[2 * i + 1];
+      const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
+      const float re = pr * qr + pi * qi;
+      const float im = pi * qr - pr * qi;
+      const float scale = ((i & 1) ? odd_factor : factor) / std::sqrt(re * re + im * im + kTinyMagnitudeSquared);
+      const float wp = std::max(0.0f, 1.0f - p_noise / (pr * pr + pi * pi + kTinyMagnitudeSquared));
+      const float wq = std::max(0.0f, 1.0f - q_noise / (qr * qr + qi * qi + kTinyMagnitudeSquared));
+      out[2 * i] = re * (scale * (wp * wq));
+      out[2 * i + 1] = im * (scale * (wp * wq));
+    }
     return;
   }
   const float odd_factor = alternate ? -factor : factor;
@@ -109,7 +131,7 @@ void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Ma
 }
 
 void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
-                       bool half_turn, SimdKernel kernel) {
+                       bool half_turn, SimdKernel kernel, float newer_noise, float older_noise) {
   requireSameShape(newer, older);
   out.create(newer.size());
   const int n = newer.rows;
@@ -118,7 +140,8 @@ void centredCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f
   const float scale = 1.0f / (static_cast<float>(n) * static_cast<float>(n));
   for (int row = 0; row < n; ++row) {
     crossPowerRun(newer.ptr<float>(row), older.ptr<float>(row), out.ptr<float>(row), newer.cols,
-                  half_turn ? -1.0f : 1.0f, (row & 1) ? -scale : scale, true, kernel);
+                  half_turn ? -1.0f : 1.0f, (row & 1) ? -scale : scale, true, kernel, newer_noise,
+                  older_noise);
   }
 }
 

@@ -306,7 +306,12 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
   }
-  centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn);
+  // The warp resamples the older frame (and its noise): its own noise power.
+  const float older_noise = !context_->config().noise_weighting ? 0.0f
+                            : result.warped                       ? noisePower(warped_spectrum_)
+                                                                  : older.noise_power;
+  centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn,
+                    SimdKernel::kAuto, newer.noise_power, older_noise);
   fft.inverseInPlace(cross_power_);
   surface_ = fft.realView(cross_power_);
   SurfacePeak peak;

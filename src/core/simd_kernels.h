@@ -45,6 +45,12 @@ static inline void sampleLine(const LineSamples& line, bool avx2) {
 void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
                        float conjugate_sign, float factor, bool alternate);
 
+/// The same, each value also weighted by its share of signal in both spectra,
+/// max(0, 1 - p_noise / |p|^2) max(0, 1 - q_noise / |q|^2).
+void crossPowerRowWeightedAvx2(const float* p, const float* q, float* out, int count,
+                               float conjugate_sign, float factor, bool alternate, float p_noise,
+                               float q_noise);
+
 /// out[i] = |z_i| for `count` interleaved complex values.
 void magnitudeRowAvx2(const float* complex_values, int count, float* out);
 

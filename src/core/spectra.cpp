@@ -137,6 +137,30 @@ void upperHalfMagnitude(const cv::Mat2f& spectrum, const cv::Mat1f& filter, cv::
   }
 }
 
+float noisePower(const cv::Mat2f& spectrum) {
+  const int n = spectrum.rows;
+  const int cols = spectrum.cols;
+  const double inner = 0.4 * n;
+  std::vector<float> ring;
+  ring.reserve(static_cast<std::size_t>(n) * cols / 4);
+  // Every other frequency is plenty for a quartile.
+  for (int row = 0; row < n; row += 2) {
+    const double fy = row < n / 2 ? row : row - n;
+    const float* values = spectrum.ptr<float>(row);
+    const int first = fy * fy >= inner * inner ? 0 : static_cast<int>(std::ceil(std::sqrt(inner * inner - fy * fy)));
+    for (int col = first; col < cols; col += 2) {
+      const float re = values[2 * col], im = values[2 * col + 1];
+      const float power = re * re + im * im;
+      if (std::isfinite(power)) ring.push_back(power);
+    }
+  }
+  if (ring.empty()) return 0.0f;
+  const auto quartile = ring.begin() + ring.size() / 4;
+  std::nth_element(ring.begin(), quartile, ring.end());
+  // The lower quartile of an exponential distribution is ln(4/3) times its mean.
+  return static_cast<float>(*quartile / std::log(4.0 / 3.0));
+}
+
 std::string fftPlanningNotice(const RegistrationConfig& config) {
   if (fftPlansKnown(config.size, config.fft_planning)) return std::string();
   const std::string n = std::to_string(config.size);
@@ -186,6 +210,7 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   cv::Mat1f windowed = fft.inPlaceInput(frame.spectrum);
   context_->window().apply(frame.grey, windowed, frame.mean);
   fft.forwardInPlace(frame.spectrum);
+  if (context_->config().noise_weighting) frame.noise_power = noisePower(frame.spectrum);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   cv::Mat1f log_polar = fft.inPlaceInput(frame.log_polar_spectrum);
   context_->logPolar(magnitude_, log_polar);

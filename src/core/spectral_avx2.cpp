@@ -71,6 +71,44 @@ void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
   }
 }
 
+void crossPowerRowWeightedAvx2(const float* p, const float* q, float* out, int count,
+                               float conjugate_sign, float factor, bool alternate, float p_noise,
+                               float q_noise) {
+  const float odd_factor = alternate ? -factor : factor;
+  const __m256 sign = _mm256_setr_ps(1.0f, conjugate_sign, 1.0f, conjugate_sign, 1.0f,
+                                     conjugate_sign, 1.0f, conjugate_sign);
+  const __m256 tiny = _mm256_set1_ps(kTinyMagnitudeSquared);
+  const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  const __m256 pn = _mm256_set1_ps(p_noise), qn = _mm256_set1_ps(q_noise);
+  const __m256 factors = _mm256_setr_ps(factor, factor, odd_factor, odd_factor, factor, factor,
+                                        odd_factor, odd_factor);
+  // Each lane's squared magnitude of its complex value: (re^2 + im^2) in both lanes of a pair.
+  const auto norms = [](__m256 v) {
+    const __m256 squares = _mm256_mul_ps(v, v);
+    return _mm256_add_ps(squares, _mm256_permute_ps(squares, 0xB1));
+  };
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const __m256 product = complexProducts(p + 2 * i, q + 2 * i, sign);
+    const __m256 scale = _mm256_div_ps(factors, _mm256_sqrt_ps(_mm256_add_ps(norms(product), tiny)));
+    const __m256 wp = _mm256_max_ps(zero, _mm256_sub_ps(one, _mm256_div_ps(pn, _mm256_add_ps(norms(_mm256_loadu_ps(p + 2 * i)), tiny))));
+    const __m256 wq = _mm256_max_ps(zero, _mm256_sub_ps(one, _mm256_div_ps(qn, _mm256_add_ps(norms(_mm256_loadu_ps(q + 2 * i)), tiny))));
+    _mm256_storeu_ps(out + 2 * i, _mm256_mul_ps(product, _mm256_mul_ps(scale, _mm256_mul_ps(wp, wq))));
+  }
+  for (; i < count; ++i) {
+    const float pr = p[2 * i], pi = p[2 * i + 1];
+    const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
+    const float re = pr * qr + pi * qi;
+    const float im = pi * qr - pr * qi;
+    const float scale = ((i & 1) ? odd_factor : factor) /
+                        __builtin_sqrtf(re * re + im * im + kTinyMagnitudeSquared);
+    const float wp = __builtin_fmaxf(0.0f, 1.0f - p_noise / (pr * pr + pi * pi + kTinyMagnitudeSquared));
+    const float wq = __builtin_fmaxf(0.0f, 1.0f - q_noise / (qr * qr + qi * qi + kTinyMagnitudeSquared));
+    out[2 * i] = re * (scale * (wp * wq));
+    out[2 * i + 1] = im * (scale * (wp * wq));
+  }
+}
+
 void magnitudeRowAvx2(const float* complex_values, int count, float* out) {
   int i = 0;
   for (; i + 8 <= count; i += 8) {
@@ -137,6 +175,9 @@ namespace oefmt {
 namespace detail {
 
 void crossPowerRowAvx2(const float*, const float*, float*, int, float, float, bool) { std::abort(); }
+void crossPowerRowWeightedAvx2(const float*, const float*, float*, int, float, float, bool, float, float) {
+  std::abort();
+}
 void magnitudeRowAvx2(const float*, int, float*) { std::abort(); }
 RowStats rowStatsAvx2(const float*, int) { std::abort(); }
 

@@ -142,6 +142,21 @@ TEST(Evaluation, RejectsDegenerateInput) {
   EXPECT_THROW(evaluateTrajectory(Trajectory(truth.begin(), truth.begin() + 1), truth, EvaluationOptions{}), InputError);
 }
 
+TEST(Evaluation, RigidAlignmentOfACameraThatNeverMovedIsAShift) {
+  // A spin in place: the truth stays at one point; so does a perfect estimate, elsewhere.
+  Trajectory truth = groundTruth(20);
+  for (StampedPose& pose : truth) pose.position = Eigen::Vector3d(4.0, -2.0, 30.0);
+  Trajectory estimate = truth;
+  for (StampedPose& pose : estimate) pose.position = Eigen::Vector3d(0.0, 0.0, 0.0);
+  estimate[7].position = Eigen::Vector3d(0.3, 0.0, 0.0);  // one pose 0.3 m off the others
+  EvaluationOptions options;
+  options.with_scale = false;
+  const EvaluationResult result = evaluateTrajectory(estimate, truth, options);
+  EXPECT_NEAR(result.ate.max, 0.3 * 19.0 / 20.0, 1e-9);  // the means coincide after the shift
+  for (StampedPose& pose : estimate) pose.position = Eigen::Vector3d(0.0, 0.0, 0.0);
+  EXPECT_LT(evaluateTrajectory(estimate, truth, options).ate.max, 1e-9);
+}
+
 TEST(Evaluation, ErrorStatistics) {
   const ErrorStatistics stats = errorStatistics({4.0, 1.0, 3.0, 2.0});
   EXPECT_EQ(stats.count, 4u);

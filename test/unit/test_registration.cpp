@@ -260,6 +260,33 @@ TEST(Registration, SomeNanPixelsAreReplacedAndCounted) {
   EXPECT_NEAR(r.translation.y, 3.0, 0.2);
 }
 
+TEST(Registration, NoiseWeightingKeepsADullNoisyPairConfident) {
+  // A dull texture (grey std 6 of 255) under sensor noise of 8 grey levels, moved by a known
+  // shift: with the noise-dominated frequencies weighted down the translation peak stands out;
+  // the plain phase correlation leaves it at the edge of being refused.
+  const auto pair = test::warpedPair(sim::ViewMotion{0.0, 1.0, {23.5, -41.25}});
+  const auto dull = [](const cv::Mat1f& image, int seed) {
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(image, mean, stddev);
+    cv::Mat1f out = (image - mean[0]) * ((6.0 / 255.0) / stddev[0]) + 0.5;
+    cv::Mat1f noise(image.size());
+    cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0.0, 8.0 / 255.0);
+    return cv::Mat1f(out + noise);
+  };
+  const cv::Mat1f older = dull(pair.older, 1), newer = dull(pair.newer, 2);
+  const PairRegistration weighted = test::registerImages(older, newer);
+  RegistrationConfig plain_config;
+  plain_config.noise_weighting = false;
+  plain_config.fft_planning = FftPlanning::kEstimate;
+  Registrar plain(plain_config);
+  const PairRegistration unweighted = plain.registerPair(plain.analyse(older), plain.analyse(newer));
+  EXPECT_EQ(weighted.status, RegistrationStatus::kOk);
+  EXPECT_GT(weighted.confidence, 0.6);
+  EXPECT_NEAR(weighted.translation.x, 23.5, 0.3);
+  EXPECT_NEAR(weighted.translation.y, -41.25, 0.3);
+  EXPECT_LT(unweighted.confidence, weighted.confidence - 0.4);
+}
+
 TEST(Registration, UnrelatedImagesHaveLowConfidence) {
   const auto a = test::warpedPair(sim::ViewMotion{}, kN, 21);
   const auto b = test::warpedPair(sim::ViewMotion{}, kN, 22);

@@ -50,6 +50,35 @@ TEST(SimdKernels, CrossPowerMatchesThePortableLoop) {
   }
 }
 
+TEST(SimdKernels, NoiseWeightedCrossPowerMatchesThePortableLoop) {
+  // 45 complex columns: four-wide steps and a tail of one; noise powers around the values'
+  // |.|^2 (50^2 per component), so that some weights clip at 0 and others do not.
+  const cv::Mat2f newer = randomSpectrum(16, 45, 3);
+  cv::Mat2f older = randomSpectrum(16, 45, 4);
+  older(5, 44) = cv::Vec2f(0.0f, 0.0f);  // weight 0, not NaN
+  for (const bool half_turn : {false, true}) {
+    cv::Mat2f fast, portable, plain;
+    centredCrossPower(newer, older, fast, half_turn, SimdKernel::kAuto, 4000.0f, 6000.0f);
+    centredCrossPower(newer, older, portable, half_turn, SimdKernel::kPortable, 4000.0f, 6000.0f);
+    centredCrossPower(newer, older, plain, half_turn, SimdKernel::kPortable);
+    EXPECT_LT(cv::norm(fast, portable, cv::NORM_INF), 1e-6 / (16.0 * 16.0));
+    EXPECT_EQ(fast(5, 44), cv::Vec2f(0.0f, 0.0f));
+    int zeroed = 0, kept = 0;
+    for (int r = 0; r < 16; ++r) {
+      for (int c = 0; c < 45; ++c) {
+        // Each value is the unweighted one times its weight in [0, 1].
+        const cv::Vec2f p = newer(r, c), q = older(r, c);
+        const double wp = std::max(0.0, 1.0 - 4000.0 / (p.dot(p) + 1e-30));
+        const double wq = std::max(0.0, 1.0 - 6000.0 / (q.dot(q) + 1e-30));
+        EXPECT_NEAR(portable(r, c)[0], plain(r, c)[0] * wp * wq, 1e-7);
+        (wp * wq == 0.0 ? zeroed : kept) += 1;
+      }
+    }
+    EXPECT_GT(zeroed, 50);
+    EXPECT_GT(kept, 50);
+  }
+}
+
 TEST(SimdKernels, RowStatisticsMatchThePortableLoop) {
   // 37 floats: four eight-wide steps and a tail of five; negative values for sum vs |sum|.
   cv::Mat1f row(1, 37);

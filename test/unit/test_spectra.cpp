@@ -246,6 +246,27 @@ namespace {
 
 // oefmt_offline analyses frames on several threads, each with its own builder: a frame's
 // spectra must not depend on what its builder analysed before.
+TEST(Spectra, NoisePowerOfWhiteNoiseIsItsMeanPowerPerFrequency) {
+  // The spectrum of white noise of std s over an N x N image: E|F|^2 = N^2 s^2 everywhere.
+  const int n = 256;
+  const Fft2d fft(n, FftPlanning::kEstimate);
+  for (const double sigma : {0.02, 0.2}) {
+    cv::Mat1f noise(n, n);
+    cv::RNG(11).fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+    cv::Mat2f spectrum;
+    fft.forward(noise, spectrum);
+    EXPECT_NEAR(noisePower(spectrum) / (n * n * sigma * sigma), 1.0, 0.05) << sigma;
+  }
+  // A smooth image has (almost) no power out there.
+  cv::Mat1f smooth(n, n);
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) smooth(r, c) = static_cast<float>(std::sin(0.05 * c) * std::cos(0.03 * r));
+  }
+  cv::Mat2f spectrum;
+  fft.forward(smooth, spectrum);
+  EXPECT_LT(noisePower(spectrum), 1e-3 * n * n * 0.02 * 0.02);
+}
+
 TEST(Spectra, AFramesSpectraDoNotDependOnTheBuildersHistory) {
   const auto first = test::warpedPair(sim::ViewMotion{}, 128, 5);
   const auto second = test::warpedPair(sim::ViewMotion{}, 128, 9);
