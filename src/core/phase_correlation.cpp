@@ -94,6 +94,22 @@ double widenedPeakOffset(float left, float centre, float right) {
   return weight * sincRatioOffset(left, centre, right) + (1.0 - weight) * centre_of_mass;
 }
 
+// Sub-sample offset of a smooth peak: the vertex of the parabola through log(values) (a
+// Gaussian's exact position); the plain parabola where a neighbour is not positive.
+double gaussianPeakOffset(float left, float centre, float right) {
+  if (!(centre > 0.0f)) return 0.0;
+  double offset = 0.0;
+  if (left > 0.0f && right > 0.0f) {
+    const double l = std::log(double(left)), c = std::log(double(centre)), r = std::log(double(right));
+    const double curvature = l - 2.0 * c + r;
+    if (curvature < 0.0) offset = 0.5 * (l - r) / curvature;
+  } else {
+    const double curvature = double(left) - 2.0 * centre + right;
+    if (curvature < 0.0) offset = 0.5 * (double(left) - right) / curvature;
+  }
+  return std::clamp(offset, -0.5, 0.5);
+}
+
 // The peak at `at` (of -surface when `negative`) refined on each axis by `shape`.
 SurfacePeak refinedPeak(const cv::Mat1f& surface, cv::Point at, bool negative, bool cyclic_cols,
                         PeakShape shape) {
@@ -111,7 +127,9 @@ SurfacePeak refinedPeak(const cv::Mat1f& surface, cv::Point at, bool negative, b
     }
     return sign * surface(r, c);
   };
-  const auto offset = shape == PeakShape::kDirichlet ? sincRatioOffset : widenedPeakOffset;
+  const auto offset = shape == PeakShape::kDirichlet   ? sincRatioOffset
+                      : shape == PeakShape::kBroadened ? widenedPeakOffset
+                                                       : gaussianPeakOffset;
   peak.sub_row = peak.row + offset(sample(peak.row - 1, peak.col), peak.value,
                                    sample(peak.row + 1, peak.col));
   peak.sub_col = peak.col + offset(sample(peak.row, peak.col - 1), peak.value,

@@ -348,8 +348,10 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
 double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
                                         PairRegistration& result) {
   const int n = context_->size();
+  // The noise weights smooth the peak: its sub-pixel position is a Gaussian's.
+  const PeakShape shape = context_->config().noise_weighting ? PeakShape::kGaussian : PeakShape::kDirichlet;
   SurfaceStats stats;
-  peak = findPeak(surface_, true, &stats);
+  peak = findPeak(surface_, true, &stats, shape);
   const double global = confidenceFrom(peakToSidelobeRatio(surface_, peak, stats),
                                        kTranslationPsrFloor, kTranslationPsrGood);
   result.translation_from_window = false;
@@ -363,7 +365,7 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   const SurfacePeak near = findPeakInWindow(
       surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
                           static_cast<int>(std::lround(n / 2 + predicted.y))),
-      half, half, true);
+      half, half, true, shape);
   // The noise of a correlation surface reaches higher the more cells it has: the floors were
   // set for the largest of the N^2 cells; for the largest of a window's cells they shrink with
   // the logarithm of the count (the tail of the surface's values is about exponential).

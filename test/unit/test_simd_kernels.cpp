@@ -168,7 +168,7 @@ TEST(SimdKernels, LogPolarRaysMatchThePortableLoopAndBilinearSampling) {
   const SpectralContext context(config);
   const int n = config.size;
   cv::Mat1f magnitude(n / 2 + 2, n);
-  cv::randu(magnitude, 0.0f, 10.0f);
+  cv::RNG(21).fill(magnitude, cv::RNG::UNIFORM, 0.0f, 10.0f);  // seeded: not the shared RNG
   cv::Mat1f fast, portable;
   context.logPolar(magnitude, fast, SimdKernel::kAuto);
   context.logPolar(magnitude, portable, SimdKernel::kPortable);
@@ -193,7 +193,7 @@ TEST(SimdKernels, PolarRowsMatchThePortableLoopOnAPaddedSurface) {
   cv::Mat2f buffer;
   cv::Mat1f surface = context.fft().inPlaceInput(buffer);
   ASSERT_FALSE(surface.isContinuous());
-  cv::randu(surface, -1.0f, 1.0f);
+  cv::RNG(22).fill(surface, cv::RNG::UNIFORM, -1.0f, 1.0f);  // seeded: not the shared RNG
   cv::Mat1f fast, portable;
   context.polarRows(surface, -3, 7, fast, SimdKernel::kAuto);  // rows wrap below 0
   context.polarRows(surface, -3, 7, portable, SimdKernel::kPortable);
