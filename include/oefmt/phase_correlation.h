@@ -72,9 +72,12 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 
 /// The largest value within +-half_rows x +-half_cols of `centre` (x = column, y = row; rows
 /// wrap, columns wrap if cyclic_cols, else are clipped), refined as findPeak does. For a search
-/// where the motion so far says the peak must be.
+/// where the motion so far says the peak must be. With a `sigma` (columns, rows) > 0, the value
+/// weighted by a Gaussian of those widths around the centre decides: of two peaks in the
+/// window, the one the prediction expects unless the other is much higher.
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
-                             int half_cols, bool cyclic_cols, PeakShape shape = PeakShape::kDirichlet);
+                             int half_cols, bool cyclic_cols, PeakShape shape = PeakShape::kDirichlet,
+                             cv::Point2d sigma = {0.0, 0.0});
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at

@@ -75,6 +75,12 @@ struct RegistrationPrior {
   double log_zoom_sigma = 0.0;   ///< 1-sigma of the prediction [ln s]
   double rotation_window = 0.0;  ///< half width of the window [rad]
   double log_zoom_window = 0.0;  ///< half width of the window [ln s]
+  /// How closely the motion so far pins the rotation and zoom [rad, ln s]: within the window a
+  /// peak's height is weighted by a Gaussian of these widths around the prediction, so that a
+  /// nearby peak of another surface (an inclined plane, whose perspective reads as a turn and a
+  /// zoom) wins only by being much higher. 0: unweighted.
+  double rotation_spread = 0.0;
+  double log_zoom_spread = 0.0;
   /// Predicted translation d [px of the newer frame] of the followed depth layer and the radius
   /// of the window around it [px]; radius 0: no translation prediction. The highest translation
   /// peak stands when it lies in the window or on the predicted direction of motion (another

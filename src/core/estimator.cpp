@@ -205,6 +205,15 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
   double rotation_sigma = median([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
   double log_zoom_sigma = median([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
   const double rotation12 = prior.rotation, log_zoom12 = prior.log_zoom;
+  // How far the last steps strayed from the median, plus a frame interval's change of the rates
+  // (a third of the window, as for a registration on the prediction).
+  double rotation_spread = 0.0, log_zoom_spread = 0.0;
+  for (const PairMotion& m : recent_steps) {
+    rotation_spread = std::max(rotation_spread, std::fabs(m.rotation * intervals - rotation12));
+    log_zoom_spread = std::max(log_zoom_spread, std::fabs(m.log_zoom * intervals - log_zoom12));
+  }
+  prior.rotation_spread = std::hypot(rotation_spread, kPriorWindowBins * CV_PI / n / 3.0);
+  prior.log_zoom_spread = std::hypot(log_zoom_spread, kPriorWindowBins * registrar.logZoomPerBin() / 3.0);
   if (start != nullptr) {
     prior.rotation += start->rotation;
     prior.log_zoom += start->log_zoom;

@@ -222,12 +222,13 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 }
 
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
-                             int half_cols, bool cyclic_cols, PeakShape shape) {
+                             int half_cols, bool cyclic_cols, PeakShape shape, cv::Point2d sigma) {
   if (surface.empty()) throw InputError("findPeakInWindow: empty surface");
   half_rows = std::clamp(half_rows, 0, (surface.rows - 1) / 2);
   half_cols = std::clamp(half_cols, 0, (surface.cols - 1) / 2);
+  const bool weighted = sigma.x > 0.0 && sigma.y > 0.0;
   cv::Point best(wrap(centre.x, surface.cols), wrap(centre.y, surface.rows));
-  float best_value = -std::numeric_limits<float>::infinity();
+  double best_score = -std::numeric_limits<double>::infinity();
   for (int dr = -half_rows; dr <= half_rows; ++dr) {
     const float* row = surface[wrap(centre.y + dr, surface.rows)];
     for (int dc = -half_cols; dc <= half_cols; ++dc) {
@@ -237,8 +238,12 @@ SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int hal
       } else if (c < 0 || c >= surface.cols) {
         continue;
       }
-      if (row[c] > best_value) {
-        best_value = row[c];
+      double score = row[c];
+      if (weighted && score > 0.0) {
+        score *= std::exp(-0.5 * (dc * dc / (sigma.x * sigma.x) + dr * dr / (sigma.y * sigma.y)));
+      }
+      if (score > best_score) {
+        best_score = score;
         best = cv::Point(c, wrap(centre.y + dr, surface.rows));
       }
     }

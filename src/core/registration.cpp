@@ -250,7 +250,8 @@ double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistrati
                            static_cast<int>(std::lround(n / 2 + window->rotation * n / CV_PI)));
     const int half_rows = static_cast<int>(std::ceil(window->rotation_window * n / CV_PI));
     const int half_cols = static_cast<int>(std::ceil(window->log_zoom_window / log_zoom_per_bin));
-    peak = findPeakInWindow(surface, centre, half_rows, half_cols, true, PeakShape::kBroadened);
+    const cv::Point2d sigma(window->log_zoom_spread / log_zoom_per_bin, window->rotation_spread * n / CV_PI);
+    peak = findPeakInWindow(surface, centre, half_rows, half_cols, true, PeakShape::kBroadened, sigma);
   }
   peak_at = cv::Point(peak.col, peak.row);
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
