@@ -229,6 +229,7 @@ def main():
     parser.add_argument("--modes", default=",".join(MODES))
     parser.add_argument("--check", action="store_true", help="exit 1 when a requirement fails")
     parser.add_argument("--markdown", help="also write the table as Markdown to this file")
+    parser.add_argument("--junit", help="also write the requirements as JUnit test cases (for the test summary)")
     parser.add_argument("--list", action="store_true", help="print the corpus and exit")
     args = parser.parse_args()
 
@@ -280,10 +281,30 @@ def main():
         sys.stdout.flush()
 
     failures = report(results, coverage, modes, args.markdown)
+    if args.junit:
+        write_junit(args.junit, results, failures)
     if args.check and failures:
         print("\nrequirements not met:\n  " + "\n  ".join(failures))
         return 1
     return 0
+
+
+def write_junit(path, results, failures):
+    """One test case per requirement of REQUIREMENTS (and the comparison with the other modes),
+    failing with the flights that break it."""
+    import xml.etree.ElementTree as ElementTree
+    checks = {"drift": ": drift ", "heading": "heading steps off", "lost": "frames lost",
+              "ate_against_other_modes": "< oefmt's", "time_ratio": "median time ratio",
+              "sigmas": "within 2 sigma"}
+    suite = ElementTree.Element("testsuite", name="generalization", tests=str(len(checks)))
+    for name, marker in checks.items():
+        case = ElementTree.SubElement(suite, "testcase", classname="Generalization", name=name)
+        broken = [f for f in failures if marker in f]
+        if broken:
+            ElementTree.SubElement(case, "failure", message="; ".join(broken))
+    ElementTree.SubElement(suite, "system-out").text = "flights: " + ", ".join(r["name"] for r in results)
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    ElementTree.ElementTree(suite).write(path, encoding="utf-8", xml_declaration=True)
 
 
 def cell(value, digits=2):

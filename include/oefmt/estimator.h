@@ -43,6 +43,9 @@ struct Estimate {
   /// or the optimizer fell back to raw measurements, or the pair was only just usable).
   bool degraded = false;
   int frame_gap = 0;  ///< frame intervals between frame 1 and this frame (1 unless frames failed)
+  /// The measured step departed from the motion so far by more than the vehicle's acceleration
+  /// allows: the predicted step was integrated instead (with a covariance covering both).
+  bool step_implausible = false;
 
   // Raw registrations (energy vectors included; empty vectors in fmt mode).
   PairRegistration registration12;

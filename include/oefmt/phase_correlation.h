@@ -74,10 +74,12 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 /// wrap, columns wrap if cyclic_cols, else are clipped), refined as findPeak does. For a search
 /// where the motion so far says the peak must be. With a `sigma` (columns, rows) > 0, the value
 /// weighted by a Gaussian of those widths around the centre decides: of two peaks in the
-/// window, the one the prediction expects unless the other is much higher.
+/// window, the one the prediction expects unless the other is much higher (only local maxima
+/// compete then). Positions within one cell of `exclude` are skipped (a peak already taken). When
+/// nothing qualifies, the result has value 0.
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
                              int half_cols, bool cyclic_cols, PeakShape shape = PeakShape::kDirichlet,
-                             cv::Point2d sigma = {0.0, 0.0});
+                             cv::Point2d sigma = {0.0, 0.0}, cv::Point exclude = {-10, -10});
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at

@@ -55,6 +55,14 @@ struct PairRegistration {
   /// The surface's highest peak was off the predicted motion and nothing in the window stood
   /// out: the registration is not confident.
   bool translation_implausible = false;
+  /// With a predicted translation: the peak the prediction points at (the highest within its
+  /// window, weighted towards the prediction) [px of B], and its confidence as a peak of that
+  /// window (0 when none stood out). The followed depth layer's, when another layer's peak is
+  /// the highest.
+  cv::Point2d followed_translation;
+  double followed_confidence = 0.0;
+  /// The rotation or zoom lay outside the prior's window: not confident, whatever the peaks.
+  bool rotation_zoom_implausible = false;
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
   bool warped = true;
@@ -63,11 +71,12 @@ struct PairRegistration {
 };
 
 /// What the motion so far predicts for a pair's rotation and zoom. The rotation/zoom surface's
-/// highest value within the window is tried first, then the surface's highest peaks, and last
-/// the predicted rotation and zoom themselves: low overlap, weak texture and repetitive patterns
-/// weaken the true rotation/zoom peak long before the translation peak, and another peak can be
-/// the highest. A registration on the predicted values (rotation_zoom_candidate kPredicted)
-/// measured only the translation; its rotation and zoom carry the prediction's sigmas.
+/// highest values within the window are tried, and last the predicted rotation and zoom
+/// themselves: low overlap, weak texture and repetitive patterns weaken the true rotation/zoom
+/// peak long before the translation peak, and another peak can be the highest. A result
+/// outside the window (a half turn) is ruled out. A registration on the predicted values
+/// (rotation_zoom_candidate kPredicted) measured only the translation; its rotation and zoom
+/// carry the prediction's sigmas.
 struct RegistrationPrior {
   double rotation = 0.0;         ///< predicted theta [rad]
   double log_zoom = 0.0;         ///< predicted ln s
@@ -90,6 +99,9 @@ struct RegistrationPrior {
   /// registration is not confident (a repetitive texture's alias, or a pair that does not match).
   cv::Point2d translation;
   double translation_radius = 0.0;
+  /// How far the last steps strayed from the prediction's constant motion [px]: its own
+  /// uncertainty, without the vehicle's possible acceleration.
+  double translation_sigma = 0.0;
 };
 
 /// Correlation surfaces of the last registration, for diagnostics and plots.
@@ -132,15 +144,25 @@ class Registrar {
  private:
   // The rotation/zoom correlation surface of the pair, into rotation_zoom_surface_.
   void correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer);
-  // Rotation, zoom, translation and confidence with the highest peak left on the rotation/zoom
-  // surface, or (in_window) the highest within the prior's window; `peak` receives it. The
-  // prior's translation, if any, guides the translation peak either way.
+  // Rotation, zoom, translation and confidence with the given peak of the rotation/zoom
+  // surface. The prior's translation, if any, guides the translation peak.
   void registerOnce(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
-                    PairRegistration& result, cv::Point& peak, RegistrationSurfaces* surfaces,
-                    const RegistrationPrior* prior, bool in_window);
+                    PairRegistration& result, const SurfacePeak& rotation_zoom_peak,
+                    RegistrationSurfaces* surfaces, const RegistrationPrior* prior);
+  // The registration with the peaks of the prior's window (see RegistrationPrior).
+  PairRegistration registerInWindow(const FrameSpectra& older, const FrameSpectra& newer,
+                                    RegistrationMethod method, const RegistrationPrior& prior,
+                                    RegistrationSurfaces* surfaces);
   // Each returns the peak-to-sidelobe ratio of its correlation surface.
-  double registerRotationZoom(RegistrationMethod method, PairRegistration& result, cv::Point& peak,
-                              const RegistrationPrior* window);
+  double registerRotationZoom(RegistrationMethod method, PairRegistration& result,
+                              const SurfacePeak& peak);
+  // The rotation/zoom surface's position of the prior's prediction (x = column, y = row).
+  cv::Point2d windowCentre(const RegistrationPrior& window) const;
+  // The highest peak of the rotation/zoom surface within the prior's window, weighted towards
+  // the prediction (findPeakInWindow), other than the peak at `exclude`.
+  SurfacePeak windowPeak(const RegistrationPrior& window, cv::Point exclude = {-10, -10}) const;
+  // That Gaussian weight of a surface position.
+  double windowWeight(const RegistrationPrior& window, cv::Point peak) const;
   // The translation alone, with the prior's rotation and zoom.
   void registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
                        const RegistrationPrior& prior, PairRegistration& result,
@@ -160,6 +182,8 @@ class Registrar {
   cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
   cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)
   cv::Mat1f rotation_zoom_surface_;  // a view of rotation_zoom_power_
+  SurfaceStats rotation_zoom_stats_;  // of the whole surface, for the peak-to-sidelobe ratios
+  SurfacePeak rotation_zoom_highest_;
   cv::Mat1f small_surface_, polar_;
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;

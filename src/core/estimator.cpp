@@ -100,6 +100,8 @@ struct Estimator::State {
     anchor.reset();
     last_step.reset();
     recent_steps.clear();
+    implausible_steps = 0;
+    unconfirmed_steps = 0;
     started = false;
     last_stamp = -std::numeric_limits<double>::infinity();
   }
@@ -122,6 +124,11 @@ struct Estimator::State {
   void advance(WindowFrame&& frame, const PairMotion& step, std::vector<float>&& next_translation01,
                Estimate& est);
   cv::Matx44d heldGrowth() const;
+  // The step against the motion so far: one the vehicle could not have made (further from the
+  // prediction than the acceleration window) is replaced by the prediction, with a covariance
+  // that covers the difference, and marked degraded; after tracking.max_failed_frames such steps
+  // in a row the measurements are believed and the motion model starts over.
+  PairMotion plausibleStep(const PairMotion& step, Estimate& est);
   // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
   // registered: even its slowest layer (of those pair 0-1 saw) must stay within
   // kMaxPairShiftFraction of N along both axes.
@@ -160,6 +167,8 @@ struct Estimator::State {
   // The last accepted motions per frame interval, newest last (kept through restarts: the
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
   std::deque<PairMotion> recent_steps;
+  int implausible_steps = 0;  // steps in a row replaced by the prediction (plausibleStep)
+  int unconfirmed_steps = 0;  // steps in a row that did not enter recent_steps
   bool started = false;
   double last_stamp = -std::numeric_limits<double>::infinity();
 
@@ -227,17 +236,31 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
   prior.rotation_sigma = std::hypot(rotation_sigma, kPriorWindowBins * CV_PI / n / 3.0);
   prior.log_zoom_sigma = std::hypot(log_zoom_sigma, kPriorWindowBins * registrar.logZoomPerBin() / 3.0);
   if (last_step && seconds > 0.0) {
-    // The translation per interval in the camera's axes (steady in a coordinated turn), and how
-    // far the last steps strayed from it.
-    const cv::Point2d per_interval(median([](const PairMotion& m) { return m.translation.x; }),
-                                   median([](const PairMotion& m) { return m.translation.y; }));
-    double spread = 0.0;
-    for (const PairMotion& m : recent_steps) {
-      spread = std::max(spread, cv::norm(m.translation - per_interval) +
-                                    std::sqrt(std::max(cv::trace(m.translation_covariance), 0.0)));
+    // The translation per interval in the camera's axes: the median length of the last steps,
+    // and the last direction turned on by the median turn between steps (steady in a
+    // coordinated turn, turning steadily when the heading is held on a curve).
+    const double length = median([](const PairMotion& m) { return m.shift(); });
+    double direction = recent_steps.back().direction();
+    double turn_spread = 0.0;
+    if (recent_steps.size() >= 2) {
+      std::vector<double> turns;
+      for (std::size_t k = 1; k < recent_steps.size(); ++k) {
+        turns.push_back(wrapToPi(recent_steps[k].direction() - recent_steps[k - 1].direction()));
+      }
+      const std::vector<double> all_turns = turns;
+      std::nth_element(turns.begin(), turns.begin() + turns.size() / 2, turns.end());
+      const double turn = turns[turns.size() / 2];
+      direction += turn;
+      for (const double t : all_turns) turn_spread = std::max(turn_spread, std::fabs(t - turn));
     }
+    const cv::Point2d per_interval = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
+    // How far the last steps strayed from it: along (their lengths) and across (their turns).
+    double spread = 0.0;
+    for (const PairMotion& m : recent_steps) spread = std::max(spread, std::fabs(m.shift() - length));
+    spread = std::hypot(spread, turn_spread * length);
     prior.translation = per_interval * intervals;
     double uncertainty = spread * intervals;
+    prior.translation_sigma = uncertainty;
     if (start != nullptr) {
       // d02 = s12 R(theta12) d01 + d12.
       prior.translation += rotateImageVector(start->translation, rotation12) * std::exp(log_zoom12);
@@ -316,6 +339,9 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   forgetPair01();
   anchor.reset();
   last_step.reset();
+  // Nothing of the motion before carries over: the next registrations search everywhere.
+  recent_steps.clear();
+  implausible_steps = 0;
   failed = 0;
   if (textured) {
     f1 = std::move(frame);
@@ -323,6 +349,29 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   } else {
     f1.reset();
   }
+}
+
+PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est) {
+  if (!prior12 || !(prior12->translation_radius > 0.0)) return step;
+  const cv::Point2d off = step.translation - prior12->translation;
+  if (cv::norm(off) <= prior12->translation_radius) {
+    implausible_steps = 0;
+    return step;
+  }
+  if (++implausible_steps > config.tracking.max_failed_frames) {
+    // The measurements have disagreed with the model for longer than frames may fail: the
+    // vehicle did change its motion. Believe them from here.
+    implausible_steps = 0;
+    recent_steps.clear();
+    return step;
+  }
+  est.degraded = true;
+  est.step_implausible = true;
+  PairMotion predicted = step;
+  predicted.translation = prior12->translation;
+  const double spread = cv::norm(off);
+  predicted.translation_covariance = step.translation_covariance + cv::Matx22d::eye() * (spread * spread);
+  return predicted;
 }
 
 void Estimator::State::slideTo(WindowFrame&& frame, const PairMotion& predicted) {
@@ -392,6 +441,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   ref.shift_sigma = alongTrackSigma(motion01);
   ref.raw_log_zoom = raw_log_zoom01;
   ref.raw_log_zoom_sigma = raw_log_zoom_sigma01;
+  ref.translation_energy = &translation01;
 
   // Pattern matching against pair 0-1's energy vectors: stretches ~ gap ratios, shifts ~ 0.
   const MatchingConfig& mc = config.matching;
@@ -424,18 +474,23 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   PairMotion initial12;
   const PairObservations obs12 =
       detail::observe(reg12, est.measured12, est.pmt12, est.pms12, ref, config, shift_per_bin,
-                      log_zoom_per_bin, double(gap12) / gap01, initial12);
+                      log_zoom_per_bin, double(gap12) / gap01, prior12 ? &*prior12 : nullptr, initial12);
   est.translation_use12 = obs12.translation_use;
   est.measured12 = initial12;
-  if (!usable02) {  // no loop: the gated measurement
-    return detail::steadyLayerStep(initial12, reg12, translation01, ref, config, shift_per_bin,
-                                   double(gap12) / gap01);
-  }
+  // With a predicted translation the observations already follow the layer (observe()).
+  const bool predicted_translation = prior12 && prior12->translation_radius > 0.0;
+  const auto followLayer = [&](const PairMotion& candidate) {
+    return predicted_translation ? candidate
+                                 : detail::steadyLayerStep(candidate, reg12, translation01,
+                                                           ref.shift * gap12 / gap01, config,
+                                                           shift_per_bin, double(gap12) / gap01);
+  };
+  if (!usable02) return followLayer(initial12);  // no loop: the gated measurement
 
   PairMotion initial02;
   const PairObservations obs02 = detail::observe(
       reg02, detail::calibrated(reg02, config.uncertainty), est.pmt02, est.pms02, ref, config,
-      shift_per_bin, log_zoom_per_bin, double(gap02) / gap01, initial02);
+      shift_per_bin, log_zoom_per_bin, double(gap02) / gap01, prior02 ? &*prior02 : nullptr, initial02);
   est.translation_use02 = obs02.translation_use;
   t = Clock::now();
   est.loop = optimizer.solve(motion01, obs12, obs02, initial12, initial02);
@@ -451,8 +506,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
     return initial12;
   }
   if (ref.shift > 0.0) est.lambda_t02 = est.loop.pair02.shift() / ref.shift;
-  return detail::steadyLayerStep(est.loop.pair12, reg12, translation01, ref, config, shift_per_bin,
-                                 double(gap12) / gap01);
+  return followLayer(est.loop.pair12);
 }
 
 void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
@@ -466,8 +520,17 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
 
   // Slide the window: the integrated 1-2 becomes the next 0-1.
   last_step = detail::perInterval(step, est.frame_gap);
-  recent_steps.push_back(*last_step);
-  if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
+  // A prediction standing in for a step (or for its direction) says nothing new. When the
+  // measurements keep disagreeing with the prediction for longer than frames may fail, the motion
+  // changed: the model starts over from the measurements.
+  if (!est.step_implausible && est.translation_use12 != PairObservations::TranslationUse::kNone) {
+    recent_steps.push_back(*last_step);
+    if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
+    unconfirmed_steps = 0;
+  } else if (++unconfirmed_steps > config.tracking.max_failed_frames) {
+    recent_steps.clear();
+    unconfirmed_steps = 0;
+  }
   motion01 = step;
   translation01 = std::move(next_translation01);
   zoom01 = est.registration12.zoom_energy;
@@ -595,6 +658,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       } else if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01) {
         step = s.oefmtStep(frame, est, with02);
       }
+      if (config_.mode == EstimatorMode::kOefmt) step = s.plausibleStep(step, est);
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }
   }

@@ -23,6 +23,79 @@ PairMotion withLength(const PairMotion& motion, double length, double along, dou
   return out;
 }
 
+// Smallest gate [px] between the followed layer's predicted and measured shift: sub-pixel noise.
+constexpr double kMinLayerGatePx = 1.5;
+
+// observe() with a predicted translation: which peak is the followed layer's (see the header).
+// Depth layers of one motion lie along one direction at different lengths: the length tells the
+// layer; the direction only has to be the motion's (within the acceleration window).
+void observeFollowedLayer(const PairRegistration& registration, const PairMotion& measured,
+                          const MatchResult& pmt, const Reference& ref, const EstimatorConfig& config,
+                          double shift_per_bin, double intervals, const RegistrationPrior& prior,
+                          PairObservations& obs, PairMotion& initial) {
+  const cv::Point2d predicted = prior.translation;
+  const double length = cv::norm(predicted);
+  const double gate =
+      std::max({config.tracking.layer_gate * length, 3.0 * prior.translation_sigma, kMinLayerGatePx});
+  // Distance of a shift from the predicted direction's line, and whether it lies on the motion.
+  const auto across = [&](const cv::Point2d& d) {
+    return length > 0.0 ? std::fabs(d.x * predicted.y - d.y * predicted.x) / length : cv::norm(d);
+  };
+  const auto alongMotion = [&](const cv::Point2d& d) {
+    return across(d) <= prior.translation_radius && d.dot(predicted) >= 0.0;
+  };
+  const auto followed = [&](const cv::Point2d& d) {
+    return alongMotion(d) && std::fabs(cv::norm(d) - length) <= gate;
+  };
+  if (followed(measured.translation)) return;  // the correlation peak is the layer's
+  if (registration.followed_confidence >= config.registration.min_confidence &&
+      followed(registration.followed_translation)) {
+    // Another layer's peak is the highest; the followed one stands out where it was predicted.
+    // A lower peak than the correlation's: twice its sigma.
+    obs.translation = registration.followed_translation;
+    obs.translation_covariance = measured.translation_covariance * 4.0;
+    initial = measured;
+    initial.translation = obs.translation;
+    initial.translation_covariance = obs.translation_covariance;
+    return;
+  }
+  // The followed layer is not in view. A correlation peak along the motion is another layer of
+  // it (its direction holds); off it, an alias (nothing of it holds).
+  const bool on_direction = measured.shift() > 0.0 && alongMotion(measured.translation);
+  const std::vector<float> none;
+  const PairMotion layered =
+      steadyLayerStep(measured, registration, ref.translation_energy ? *ref.translation_energy : none,
+                      length, config, shift_per_bin, intervals);
+  // The energy vectors' stretch, where it differs from the peak's: the peak is another layer.
+  const bool pmt_says_other_layer =
+      pmt.valid && std::fabs(measured.shift() - pmt.value * ref.shift) > gate &&
+      std::fabs(pmt.value * ref.shift - length) <= prior.translation_radius;
+  if (layered.translation == measured.translation && !pmt_says_other_layer) {
+    // No layer tells the followed one's length: a peak the vehicle can reach is the motion's
+    // change (its layer is followed from here).
+    if (on_direction && cv::norm(measured.translation - predicted) <= prior.translation_radius) return;
+  }
+  obs.translation_use = on_direction ? PairObservations::TranslationUse::kDirection
+                                     : PairObservations::TranslationUse::kNone;
+  double along = length, along_sigma = prior.translation_radius / 3.0;
+  if (layered.translation != measured.translation) {
+    along = layered.shift();
+    along_sigma = alongTrackSigma(layered);
+  } else if (pmt_says_other_layer || (pmt.valid && std::fabs(pmt.value * ref.shift - length) <= gate)) {
+    along = pmt.value * ref.shift;
+    along_sigma = std::hypot(along * pmt.sigma, pmt.value * ref.shift_sigma);
+  }
+  along_sigma = std::max(along_sigma, kMinShiftSigma);
+  obs.shift.push_back({along, along_sigma});
+  const double across_measured = std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0));
+  initial = withLength(measured, along, along_sigma, std::max(along * 0.01, across_measured));
+  if (!on_direction) {
+    const double direction = std::atan2(predicted.y, predicted.x);
+    initial.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * along;
+    initial.translation_covariance = alongAcrossCovariance(direction, along_sigma, prior.translation_radius / 3.0);
+  }
+}
+
 }  // namespace
 
 PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
@@ -93,18 +166,25 @@ ShiftMatchOptions shiftOptions(const MatchingConfig& m) {
 PairObservations observe(const PairRegistration& registration, const PairMotion& measured,
                          const MatchResult& pmt, const MatchResult& pms, const Reference& ref,
                          const EstimatorConfig& config, double shift_per_bin,
-                         double log_zoom_per_bin, double intervals, PairMotion& initial) {
+                         double log_zoom_per_bin, double intervals, const RegistrationPrior* prior,
+                         PairMotion& initial) {
   PairObservations obs = PairObservations::fromMotion(measured);
   initial = measured;
+  const bool predicted_translation = prior != nullptr && prior->translation_radius > 0.0;
   if (config.tracking.motion_prior_sigma > 0.0) {
-    // Pair 0-1's motion continued over this pair's frame intervals.
-    const cv::Point2d predicted = ref.translation * intervals;
+    // The motion so far continued over this pair's frame intervals.
+    const cv::Point2d predicted = predicted_translation ? prior->translation : ref.translation * intervals;
     const double sigma = config.tracking.motion_prior_sigma * cv::norm(predicted) + 1.0;
     obs.translation_priors.push_back({predicted, cv::Matx22d::eye() * (sigma * sigma)});
   }
   if (pms.valid) {
     obs.log_zoom.push_back({ref.raw_log_zoom - pms.value * log_zoom_per_bin,
                             std::hypot(pms.sigma * log_zoom_per_bin, ref.raw_log_zoom_sigma)});
+  }
+  if (predicted_translation) {
+    observeFollowedLayer(registration, measured, pmt, ref, config, shift_per_bin, intervals, *prior, obs,
+                         initial);
+    return obs;
   }
   if (!pmt.valid) return obs;
   const double predicted = pmt.value * ref.shift;
@@ -131,10 +211,9 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 }
 
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
-                           const std::vector<float>& translation01, const Reference& reference,
+                           const std::vector<float>& translation01, double steady,
                            const EstimatorConfig& config, double shift_per_bin, double intervals) {
   const TrackingConfig& tracking = config.tracking;
-  const double steady = reference.shift * intervals;
   const double length = candidate.shift();
   if (!(shift_per_bin > 0.0) || !(steady > 4.0 * config.matching.skip_bins * shift_per_bin) ||
       !(length > 0.0) || std::fabs(length - steady) <= tracking.layer_gate * steady) {

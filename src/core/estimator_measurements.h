@@ -37,6 +37,7 @@ struct Reference {
   double shift_sigma = 0.0;         ///< its 1-sigma
   double raw_log_zoom = 0.0;        ///< ln s of the registration that produced S01
   double raw_log_zoom_sigma = 0.0;
+  const std::vector<float>* translation_energy = nullptr;  ///< T01 (may be empty)
 };
 
 /// The optimizer observations of one pair (1-2 or 0-2) spanning `intervals` times pair 0-1's
@@ -47,10 +48,21 @@ struct Reference {
 ///   only its direction is kept and the translation energy peak nearest to the prediction (the
 ///   followed layer) gives the length;
 /// - a weak prior that the pair continues pair 0-1's motion (tracking.motion_prior_sigma).
+///
+/// With a predicted translation (`prior`, from the motion so far), the prediction decides which
+/// peak is the followed layer's instead of the PMT: the correlation peak when it lies within
+/// tracking.layer_gate of the prediction, else the peak the prediction points at
+/// (PairRegistration::followed_translation) when it stands out; else the followed layer is not
+/// in view: the layers of steadyLayerStep (the followed layer's trace in the energy vector, or a
+/// layer seen in both pairs) give its length and the correlation peak its direction if that
+/// lies on the predicted one (another layer of the same motion; otherwise nothing of it: a
+/// repetitive texture's alias); where no layer tells, a correlation peak within the
+/// acceleration window stands (the motion changed), else the prediction's length.
 PairObservations observe(const PairRegistration& registration, const PairMotion& measured,
                          const MatchResult& pmt, const MatchResult& pms, const Reference& reference,
                          const EstimatorConfig& config, double shift_per_bin,
-                         double log_zoom_per_bin, double intervals, PairMotion& initial);
+                         double log_zoom_per_bin, double intervals, const RegistrationPrior* prior,
+                         PairMotion& initial);
 
 /// The step of pair 1-2 that keeps following one depth layer. `candidate` is the loop's step
 /// (without a loop, the gated measurement). When its length is off steady speed (pair 0-1's
@@ -68,8 +80,9 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 /// layer at steady speed and stands (one by exactly the ratio of two layers' depths cannot be
 /// told from a hop). Slow motion (a steady length within 4 x matching.skip_bins, where a static
 /// pattern's no-motion peak lies) is left alone too.
+/// `steady` is the followed layer's expected length [px] (pair 0-1's continued).
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
-                           const std::vector<float>& translation01, const Reference& reference,
+                           const std::vector<float>& translation01, double steady,
                            const EstimatorConfig& config, double shift_per_bin, double intervals);
 
 }  // namespace detail

@@ -110,6 +110,26 @@ double gaussianPeakOffset(float left, float centre, float right) {
   return std::clamp(offset, -0.5, 0.5);
 }
 
+// Whether surface(r, c) is at least each of its eight neighbours (rows wrap; columns wrap if
+// cyclic_cols, else a neighbour beyond the border does not count).
+bool isLocalMaximum(const cv::Mat1f& surface, int r, int c, bool cyclic_cols) {
+  const float v = surface(r, c);
+  for (int dr = -1; dr <= 1; ++dr) {
+    const float* row = surface[wrap(r + dr, surface.rows)];
+    for (int dc = -1; dc <= 1; ++dc) {
+      if (dr == 0 && dc == 0) continue;
+      int cc = c + dc;
+      if (cyclic_cols) {
+        cc = wrap(cc, surface.cols);
+      } else if (cc < 0 || cc >= surface.cols) {
+        continue;
+      }
+      if (row[cc] > v) return false;
+    }
+  }
+  return true;
+}
+
 // The peak at `at` (of -surface when `negative`) refined on each axis by `shape`.
 SurfacePeak refinedPeak(const cv::Mat1f& surface, cv::Point at, bool negative, bool cyclic_cols,
                         PeakShape shape) {
@@ -222,7 +242,8 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 }
 
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
-                             int half_cols, bool cyclic_cols, PeakShape shape, cv::Point2d sigma) {
+                             int half_cols, bool cyclic_cols, PeakShape shape, cv::Point2d sigma,
+                             cv::Point exclude) {
   if (surface.empty()) throw InputError("findPeakInWindow: empty surface");
   half_rows = std::clamp(half_rows, 0, (surface.rows - 1) / 2);
   half_cols = std::clamp(half_cols, 0, (surface.cols - 1) / 2);
@@ -238,15 +259,35 @@ SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int hal
       } else if (c < 0 || c >= surface.cols) {
         continue;
       }
+      const int r = wrap(centre.y + dr, surface.rows);
+      // Within a cell of the excluded peak (rows wrap, and columns when cyclic).
+      const int er = std::abs(r - exclude.y), ec = std::abs(c - exclude.x);
+      if (std::min(er, surface.rows - er) <= 1 &&
+          (cyclic_cols ? std::min(ec, surface.cols - ec) : ec) <= 1) {
+        continue;
+      }
       double score = row[c];
-      if (weighted && score > 0.0) {
+      if (weighted) {
+        // Only peaks compete: a weighted value on a peak's flank nearer the prediction must not
+        // stand in for the peak.
+        if (!(score > 0.0) || !isLocalMaximum(surface, r, c, cyclic_cols)) {
+          continue;
+        }
         score *= std::exp(-0.5 * (dc * dc / (sigma.x * sigma.x) + dr * dr / (sigma.y * sigma.y)));
       }
       if (score > best_score) {
         best_score = score;
-        best = cv::Point(c, wrap(centre.y + dr, surface.rows));
+        best = cv::Point(c, r);
       }
     }
+  }
+  if (!(best_score > -std::numeric_limits<double>::infinity())) {
+    SurfacePeak none;  // nothing qualified: no peak (value 0) at the centre
+    none.row = best.y;
+    none.col = best.x;
+    none.sub_row = best.y;
+    none.sub_col = best.x;
+    return none;
   }
   return refinedPeak(surface, best, false, cyclic_cols, shape);
 }

@@ -34,6 +34,13 @@ constexpr int kEnergyRowBand = 12;
 // the log-polar peak, narrower than a quarter turn's distance.
 constexpr int kTriedPeakRadius = 6;
 
+// Rotation/zoom peaks tried within a prediction's window: once the best is cleared, the next
+// lies at the window's edge.
+constexpr int kWindowCandidates = 2;
+// A second peak of the window whose weighted height reaches this share of the first's competes
+// with it (both are registered).
+constexpr double kCompetingPeak = 0.5;
+
 // Zeroes the (2 radius + 1)^2 window around p, rows and columns cyclic (both wrap on the
 // rotation/zoom surface).
 void clearAround(cv::Mat1f& surface, const cv::Point& p, int radius) {
@@ -130,26 +137,30 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     result.shift_sigma = n;
     return result;
   }
-  // A lattice of blocks or a repetitive texture can give a wrong rotation/zoom peak (a quarter
-  // turn, a wrong zoom) the highest value; the translation surface then shows no peak. The next
-  // highest peaks are tried until one registers: the surface is computed once, and each
-  // candidate clears the window around the one before.
   correlateRotationZoom(older, newer);
-  cv::Point peak;
-  // The predicted peak first (when there is a prediction), then the highest peaks left.
-  const int attempts = rotation_zoom_candidates_ + (prior != nullptr ? 1 : 0);
-  for (int attempt = 0; attempt < attempts; ++attempt) {
-    if (attempt > 0) clearAround(rotation_zoom_surface_, peak, kTriedPeakRadius);
-    PairRegistration trial;
-    RegistrationSurfaces trial_surfaces;
-    registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, prior,
-                 attempt == 0 && prior != nullptr);
-    if (attempt == 0 || trial.confidence > result.confidence) {
-      result = std::move(trial);
-      result.rotation_zoom_candidate = attempt;
-      if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+  if (prior != nullptr) {
+    result = registerInWindow(older, newer, method, *prior, surfaces);
+  } else {
+    // A lattice of blocks or a repetitive texture can give a wrong rotation/zoom peak (a quarter
+    // turn, a wrong zoom) the highest value; the translation surface then shows no peak. The
+    // next highest peaks are tried until one registers: the surface is computed once, and each
+    // candidate clears the window around the one before.
+    SurfacePeak peak = rotation_zoom_highest_;
+    for (int attempt = 0; attempt < rotation_zoom_candidates_; ++attempt) {
+      if (attempt > 0) {
+        clearAround(rotation_zoom_surface_, cv::Point(peak.col, peak.row), kTriedPeakRadius);
+        peak = findPeak(rotation_zoom_surface_, true, nullptr, PeakShape::kBroadened);
+      }
+      PairRegistration trial;
+      RegistrationSurfaces trial_surfaces;
+      registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, nullptr);
+      if (attempt == 0 || trial.confidence > result.confidence) {
+        result = std::move(trial);
+        result.rotation_zoom_candidate = attempt;
+        if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+      }
+      if (result.status == RegistrationStatus::kOk) break;
     }
-    if (result.status == RegistrationStatus::kOk) break;
   }
   if (prior != nullptr && result.status != RegistrationStatus::kOk) {
     PairRegistration trial;
@@ -163,12 +174,75 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   return result;
 }
 
-void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
-                             RegistrationMethod method, PairRegistration& result, cv::Point& peak,
-                             RegistrationSurfaces* surfaces, const RegistrationPrior* prior,
-                             bool in_window) {
+cv::Point2d Registrar::windowCentre(const RegistrationPrior& window) const {
+  // Rows: theta = (row - N/2) pi / N, modulo pi (the half turn is decided later); columns:
+  // ln s = -(col - N/2) ln b.
   const int n = context_->size();
-  const double psr_rotation_zoom = registerRotationZoom(method, result, peak, in_window ? prior : nullptr);
+  return {n / 2 - window.log_zoom / logZoomPerBin(), n / 2 + window.rotation * n / CV_PI};
+}
+
+SurfacePeak Registrar::windowPeak(const RegistrationPrior& window, cv::Point exclude) const {
+  const int n = context_->size();
+  const double log_zoom_per_bin = logZoomPerBin();
+  const cv::Point2d centre = windowCentre(window);
+  const int half_rows = static_cast<int>(std::ceil(window.rotation_window * n / CV_PI));
+  const int half_cols = static_cast<int>(std::ceil(window.log_zoom_window / log_zoom_per_bin));
+  const cv::Point2d sigma(window.log_zoom_spread / log_zoom_per_bin, window.rotation_spread * n / CV_PI);
+  return findPeakInWindow(rotation_zoom_surface_,
+                          cv::Point(static_cast<int>(std::lround(centre.x)), static_cast<int>(std::lround(centre.y))),
+                          half_rows, half_cols, true, PeakShape::kBroadened, sigma, exclude);
+}
+
+double Registrar::windowWeight(const RegistrationPrior& window, cv::Point peak) const {
+  const int n = context_->size();
+  const cv::Point2d centre = windowCentre(window);
+  const double sigma_cols = window.log_zoom_spread / logZoomPerBin();
+  const double sigma_rows = window.rotation_spread * n / CV_PI;
+  if (!(sigma_cols > 0.0 && sigma_rows > 0.0)) return 1.0;
+  // Rows wrap (the surface spans a half turn), columns too (circular correlation).
+  const double dr = std::remainder(peak.y - centre.y, static_cast<double>(n));
+  const double dc = std::remainder(peak.x - centre.x, static_cast<double>(n));
+  return std::exp(-0.5 * (dc * dc / (sigma_cols * sigma_cols) + dr * dr / (sigma_rows * sigma_rows)));
+}
+
+PairRegistration Registrar::registerInWindow(const FrameSpectra& older, const FrameSpectra& newer,
+                                            RegistrationMethod method, const RegistrationPrior& prior,
+                                            RegistrationSurfaces* surfaces) {
+  PairRegistration result;
+  const SurfacePeak first = windowPeak(prior);
+  registerOnce(older, newer, method, result, first, surfaces, &prior);
+  // The next peak of the window: tried when the first did not register, and when it competes
+  // with it. Two peaks that both register: one surface of the scene turned and scaled as the
+  // prediction expects, the other an inclined plane, whose perspective reads as a turn and a
+  // zoom. The one whose translation peak stands out where the followed layer was predicted wins.
+  const SurfacePeak second = windowPeak(prior, cv::Point(first.col, first.row));
+  if (!(second.value > 0.0f)) return result;
+  const double first_score = first.value * windowWeight(prior, cv::Point(first.col, first.row));
+  const double second_score = second.value * windowWeight(prior, cv::Point(second.col, second.row));
+  const bool registered = result.status == RegistrationStatus::kOk;
+  if (registered && !(prior.translation_radius > 0.0 && second_score >= kCompetingPeak * first_score)) {
+    return result;
+  }
+  PairRegistration trial;
+  RegistrationSurfaces trial_surfaces;
+  registerOnce(older, newer, method, trial, second, surfaces ? &trial_surfaces : nullptr, &prior);
+  const bool better = registered ? trial.status == RegistrationStatus::kOk &&
+                                       trial.followed_confidence > result.followed_confidence
+                                 : trial.confidence > result.confidence;
+  if (better) {
+    result = std::move(trial);
+    result.rotation_zoom_candidate = 1;
+    if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+  }
+  return result;
+}
+
+void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
+                             RegistrationMethod method, PairRegistration& result,
+                             const SurfacePeak& rotation_zoom_peak, RegistrationSurfaces* surfaces,
+                             const RegistrationPrior* prior) {
+  const int n = context_->size();
+  const double psr_rotation_zoom = registerRotationZoom(method, result, rotation_zoom_peak);
   if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
   const double translation_confidence =
       registerTranslation(older, newer, method, result, true, prior);
@@ -181,6 +255,15 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   result.confidence =
       std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
                translation_confidence);
+  // A rotation or zoom the motion so far rules out (another peak of the whole surface, a half
+  // turn the low-resolution test chose) is not taken, however well its translation matched: a
+  // repetitive pattern matches itself turned by a quarter, or scaled by its period.
+  if (prior != nullptr &&
+      (std::fabs(wrapAngle(result.rotation - prior->rotation)) > prior->rotation_window ||
+       std::fabs(std::log(result.zoom) - prior->log_zoom) > prior->log_zoom_window)) {
+    result.rotation_zoom_implausible = true;
+    result.confidence = 0.0;
+  }
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
@@ -234,26 +317,14 @@ void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpec
   // candidate).
   context_->fft().inverseInPlace(rotation_zoom_power_);
   rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
+  rotation_zoom_highest_ = findPeak(rotation_zoom_surface_, true, &rotation_zoom_stats_, PeakShape::kBroadened);
 }
 
 double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistration& result,
-                                       cv::Point& peak_at, const RegistrationPrior* window) {
+                                       const SurfacePeak& peak) {
   const int n = context_->size();
   const cv::Mat1f& surface = rotation_zoom_surface_;
   const double log_zoom_per_bin = logZoomPerBin();
-  SurfaceStats stats;
-  SurfacePeak peak = findPeak(surface, true, &stats, PeakShape::kBroadened);
-  if (window != nullptr) {
-    // Rows: theta = (row - N/2) pi / N, modulo pi (the half turn is decided later); columns:
-    // ln s = -(col - N/2) ln b.
-    const cv::Point centre(static_cast<int>(std::lround(n / 2 - window->log_zoom / log_zoom_per_bin)),
-                           static_cast<int>(std::lround(n / 2 + window->rotation * n / CV_PI)));
-    const int half_rows = static_cast<int>(std::ceil(window->rotation_window * n / CV_PI));
-    const int half_cols = static_cast<int>(std::ceil(window->log_zoom_window / log_zoom_per_bin));
-    const cv::Point2d sigma(window->log_zoom_spread / log_zoom_per_bin, window->rotation_spread * n / CV_PI);
-    peak = findPeakInWindow(surface, centre, half_rows, half_cols, true, PeakShape::kBroadened, sigma);
-  }
-  peak_at = cv::Point(peak.col, peak.row);
   // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
   result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
   result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
@@ -272,7 +343,7 @@ double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistrati
     result.rotation_sigma = widths.y * CV_PI / n;
     result.log_zoom_sigma = widths.x * log_zoom_per_bin;
   }
-  return peakToSidelobeRatio(surface, peak, stats);
+  return peakToSidelobeRatio(surface, peak, rotation_zoom_stats_);
 }
 
 double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
@@ -357,24 +428,32 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
                                        kTranslationPsrFloor, kTranslationPsrGood);
   result.translation_from_window = false;
   result.translation_implausible = false;
+  result.followed_confidence = 0.0;
   if (prior == nullptr || !(prior->translation_radius > 0.0)) return global;
 
   const double radius = std::min(prior->translation_radius, 0.25 * n);
   const cv::Point2d predicted = prior->translation;
   const cv::Point2d highest(peak.sub_col - n / 2, peak.sub_row - n / 2);
   const int half = static_cast<int>(std::ceil(radius));
+  // The window is a three-sigma bound on the prediction: within it, a peak's height is weighted
+  // by a Gaussian of a third of its radius, so that a repetitive pattern's alias near the edge
+  // wins over a weaker peak at the predicted place only by being much higher.
   const SurfacePeak near = findPeakInWindow(
       surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
                           static_cast<int>(std::lround(n / 2 + predicted.y))),
-      half, half, true, shape);
+      half, half, true, shape, cv::Point2d(radius / 3.0, radius / 3.0));
   // The noise of a correlation surface reaches higher the more cells it has: the floors were
   // set for the largest of the N^2 cells; for the largest of a window's cells they shrink with
   // the logarithm of the count (the tail of the surface's values is about exponential).
   const double cells = (2.0 * half + 1.0) * (2.0 * half + 1.0);
   const double shrink = std::log(cells) / std::log(static_cast<double>(n) * n);
-  const double windowed = confidenceFrom(peakToSidelobeRatio(surface_, near, stats),
-                                         kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink) *
-                          std::clamp(double(near.value) / std::max(double(peak.value), 1e-12), 0.0, 1.0);
+  const double near_confidence = confidenceFrom(peakToSidelobeRatio(surface_, near, stats),
+                                                kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink);
+  result.followed_translation = cv::Point2d(near.sub_col - n / 2, near.sub_row - n / 2);
+  result.followed_confidence = near_confidence;
+  // Against the highest peak, a lower one counts as much less.
+  const double windowed =
+      near_confidence * std::clamp(double(near.value) / std::max(double(peak.value), 1e-12), 0.0, 1.0);
   // The highest peak is plausible in the window, or on the predicted direction at up to twice or
   // half the predicted length (another depth layer of the same motion).
   const double length = std::hypot(predicted.x, predicted.y);
