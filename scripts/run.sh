@@ -69,6 +69,10 @@ run_tests() {
   # Unit tests under ASan+UBSan and every libFuzzer target for 20 s (one separate clang build
   # in $build/hardening); their JUnit files join the others, so the summary judges them too.
   OEFMT_RESULTS_DIR="$build/test_results/oefmt" bash "$repo/scripts/hardening.sh" "$build/hardening" 20 || true
+  # The generalization benchmark's small subset of generated flights, all three modes, its
+  # requirements as JUnit cases (the whole corpus: scripts/generalization_benchmark.py).
+  /usr/bin/python3 "$repo/scripts/generalization_benchmark.py" --subset ci --tools "$build/devel/lib/oefmt" \
+    --work "$build/generalization" --junit "$build/test_results/oefmt/generalization.xml" || true
   # Show catkin's own view of failures, then count cases (catkin double-counts gtest cases).
   catkin_test_results "$build/test_results" 2>&1 | grep -E -v "^(Skipping|Summary)" || true
   /usr/bin/python3 "$repo/scripts/test_summary.py" "$build/test_results"
