@@ -2,6 +2,8 @@
 // Phase correlation building blocks: cross-power spectrum, centred correlation surface, peak.
 #pragma once
 
+#include <limits>
+
 #include <opencv2/core.hpp>
 
 #include "oefmt/fft.h"
@@ -75,11 +77,12 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 /// where the motion so far says the peak must be. With a `sigma` (columns, rows) > 0, the value
 /// weighted by a Gaussian of those widths around the centre decides: of two peaks in the
 /// window, the one the prediction expects unless the other is much higher (only local maxima
-/// compete then). Positions within one cell of `exclude` are skipped (a peak already taken). When
-/// nothing qualifies, the result has value 0.
+/// compete then). Positions within one cell of `exclude`, and values below `min_value`, are
+/// skipped (a peak already taken; the noise). When nothing qualifies, the result has value 0.
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
                              int half_cols, bool cyclic_cols, PeakShape shape = PeakShape::kDirichlet,
-                             cv::Point2d sigma = {0.0, 0.0}, cv::Point exclude = {-10, -10});
+                             cv::Point2d sigma = {0.0, 0.0}, cv::Point exclude = {-10, -10},
+                             float min_value = -std::numeric_limits<float>::infinity());
 
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at

@@ -243,7 +243,7 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
                              int half_cols, bool cyclic_cols, PeakShape shape, cv::Point2d sigma,
-                             cv::Point exclude) {
+                             cv::Point exclude, float min_value) {
   if (surface.empty()) throw InputError("findPeakInWindow: empty surface");
   half_rows = std::clamp(half_rows, 0, (surface.rows - 1) / 2);
   half_cols = std::clamp(half_cols, 0, (surface.cols - 1) / 2);
@@ -267,6 +267,8 @@ SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int hal
         continue;
       }
       double score = row[c];
+      // The weight is at most 1: a value no higher than the best score cannot win.
+      if (!(score > best_score) || !(row[c] >= min_value)) continue;
       if (weighted) {
         // Only peaks compete: a weighted value on a peak's flank nearer the prediction must not
         // stand in for the peak.

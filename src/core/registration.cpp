@@ -438,15 +438,20 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   // The window is a three-sigma bound on the prediction: within it, a peak's height is weighted
   // by a Gaussian of a third of its radius, so that a repetitive pattern's alias near the edge
   // wins over a weaker peak at the predicted place only by being much higher.
-  const SurfacePeak near = findPeakInWindow(
-      surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
-                          static_cast<int>(std::lround(n / 2 + predicted.y))),
-      half, half, true, shape, cv::Point2d(radius / 3.0, radius / 3.0));
   // The noise of a correlation surface reaches higher the more cells it has: the floors were
   // set for the largest of the N^2 cells; for the largest of a window's cells they shrink with
   // the logarithm of the count (the tail of the surface's values is about exponential).
   const double cells = (2.0 * half + 1.0) * (2.0 * half + 1.0);
   const double shrink = std::log(cells) / std::log(static_cast<double>(n) * n);
+  // Values below half that floor could not make a peak of any confidence: not searched.
+  const double count = static_cast<double>(surface_.total());
+  const double mean = stats.abs_sum / count;
+  const double deviation = std::sqrt(std::max(stats.square_sum / count - mean * mean, 0.0));
+  const float noise_level = static_cast<float>(mean + 0.5 * kTranslationPsrFloor * shrink * deviation);
+  const SurfacePeak near = findPeakInWindow(
+      surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
+                          static_cast<int>(std::lround(n / 2 + predicted.y))),
+      half, half, true, shape, cv::Point2d(radius / 3.0, radius / 3.0), cv::Point(-10, -10), noise_level);
   const double near_confidence = confidenceFrom(peakToSidelobeRatio(surface_, near, stats),
                                                 kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink);
   result.followed_translation = cv::Point2d(near.sub_col - n / 2, near.sub_row - n / 2);

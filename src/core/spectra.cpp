@@ -141,14 +141,15 @@ float noisePower(const cv::Mat2f& spectrum) {
   const int n = spectrum.rows;
   const int cols = spectrum.cols;
   const double inner = 0.4 * n;
+  // Every third frequency of every third row is plenty for a quartile (thousands of values).
+  constexpr int kStride = 3;
   std::vector<float> ring;
-  ring.reserve(static_cast<std::size_t>(n) * cols / 4);
-  // Every other frequency is plenty for a quartile.
-  for (int row = 0; row < n; row += 2) {
+  ring.reserve(static_cast<std::size_t>(n) * cols / (kStride * kStride));
+  for (int row = 0; row < n; row += kStride) {
     const double fy = row < n / 2 ? row : row - n;
     const float* values = spectrum.ptr<float>(row);
     const int first = fy * fy >= inner * inner ? 0 : static_cast<int>(std::ceil(std::sqrt(inner * inner - fy * fy)));
-    for (int col = first; col < cols; col += 2) {
+    for (int col = first; col < cols; col += kStride) {
       const float re = values[2 * col], im = values[2 * col + 1];
       const float power = re * re + im * im;
       if (std::isfinite(power)) ring.push_back(power);
