@@ -100,6 +100,7 @@ struct Estimator::State {
     anchor.reset();
     last_step.reset();
     recent_steps.clear();
+    recent_rates.clear();
     implausible_steps = 0;
     unconfirmed_steps = 0;
     started = false;
@@ -167,6 +168,7 @@ struct Estimator::State {
   // The last accepted motions per frame interval, newest last (kept through restarts: the
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
   std::deque<PairMotion> recent_steps;
+  std::deque<PairMotion> recent_rates;  // of those, the steps whose rotation/zoom were measured
   int implausible_steps = 0;  // steps in a row replaced by the prediction (plausibleStep)
   int unconfirmed_steps = 0;  // steps in a row that did not enter recent_steps
   bool started = false;
@@ -201,23 +203,28 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
                                                                 const PairMotion* start) const {
   if (config.mode != EstimatorMode::kOefmt || recent_steps.empty()) return std::nullopt;
   const int n = config.registration.size;
-  // The median of the last steps' rates: one wrong step does not move the prediction.
-  const auto median = [&](auto field) {
+  // The turns and zooms come from the steps that measured them (a step on the predicted rotation
+  // and zoom would only repeat the prediction), the translations from all the last steps.
+  const std::deque<PairMotion>& rates = recent_rates.empty() ? recent_steps : recent_rates;
+  // The median of the last steps' values: one wrong step does not move the prediction.
+  const auto medianOf = [](const std::deque<PairMotion>& steps, auto field) {
     std::vector<double> values;
-    for (const PairMotion& m : recent_steps) values.push_back(field(m));
+    for (const PairMotion& m : steps) values.push_back(field(m));
     std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
     return values[values.size() / 2];
   };
+  const auto rate = [&](auto field) { return medianOf(rates, field); };
+  const auto median = [&](auto field) { return medianOf(recent_steps, field); };
   RegistrationPrior prior;
-  prior.rotation = median([](const PairMotion& m) { return m.rotation; }) * intervals;
-  prior.log_zoom = median([](const PairMotion& m) { return m.log_zoom; }) * intervals;
-  double rotation_sigma = median([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
-  double log_zoom_sigma = median([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
+  prior.rotation = rate([](const PairMotion& m) { return m.rotation; }) * intervals;
+  prior.log_zoom = rate([](const PairMotion& m) { return m.log_zoom; }) * intervals;
+  double rotation_sigma = rate([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
+  double log_zoom_sigma = rate([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
   const double rotation12 = prior.rotation, log_zoom12 = prior.log_zoom;
   // How far the last steps strayed from the median, plus a frame interval's change of the rates
   // (a third of the window, as for a registration on the prediction).
   double rotation_spread = 0.0, log_zoom_spread = 0.0;
-  for (const PairMotion& m : recent_steps) {
+  for (const PairMotion& m : rates) {
     rotation_spread = std::max(rotation_spread, std::fabs(m.rotation * intervals - rotation12));
     log_zoom_spread = std::max(log_zoom_spread, std::fabs(m.log_zoom * intervals - log_zoom12));
   }
@@ -363,6 +370,7 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
     // vehicle did change its motion. Believe them from here.
     implausible_steps = 0;
     recent_steps.clear();
+    recent_rates.clear();
     return step;
   }
   est.degraded = true;
@@ -526,9 +534,14 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
   if (!est.step_implausible && est.translation_use12 != PairObservations::TranslationUse::kNone) {
     recent_steps.push_back(*last_step);
     if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
+    if (est.registration12.rotation_zoom_candidate != PairRegistration::kPredicted) {
+      recent_rates.push_back(*last_step);
+      if (recent_rates.size() > kPredictionSteps) recent_rates.pop_front();
+    }
     unconfirmed_steps = 0;
   } else if (++unconfirmed_steps > config.tracking.max_failed_frames) {
     recent_steps.clear();
+    recent_rates.clear();
     unconfirmed_steps = 0;
   }
   motion01 = step;
