@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "oefmt/error.h"
 #include "oefmt/sim/camera_model.h"
 #include "oefmt/undistortion.h"
@@ -174,6 +176,31 @@ TEST(Undistortion, RationalModel) {
   ASSERT_TRUE(camera.distortion.rational());
   ASSERT_EQ(camera.distortion.coefficients().size(), 8u);
   expectStraightGrid(camera);
+}
+
+// Resampling blurs, and on a multi-depth scene blur shifts which layer dominates the correlation
+// (the finest texture suffers first), which shows as scale drift: bilinear undistortion made a
+// simulated circle drift 9 %, bicubic 0.3 % (the undistorted pinhole flight: 0.4 %). Fine texture
+// must come through: bilinear keeps about 0.7 of its gradient energy here, bicubic over 0.9.
+TEST(Undistortion, KeepsFineTexture) {
+  CameraParameters camera;
+  camera.intrinsics = {443.4, 443.4, 255.5, 255.5, 512, 512};
+  camera.distortion.k1 = -0.2;
+  camera.distortion.k2 = 0.05;
+  cv::Mat1f texture(512, 512);
+  cv::RNG rng(7);
+  rng.fill(texture, cv::RNG::NORMAL, 0.0, 1.0);
+  cv::GaussianBlur(texture, texture, cv::Size(), 0.8);
+  const cv::Mat1f undistorted = Undistorter(camera, {512, 512}).apply(texture);
+  // Near the centre the lens hardly scales (magnification 1 .. 1.02): what is lost there is blur.
+  const auto gradientEnergy = [](const cv::Mat1f& image) {
+    const cv::Mat1f centre = image(cv::Rect(128, 128, 256, 256));
+    cv::Mat1f dx, dy;
+    cv::Sobel(centre, dx, CV_32F, 1, 0, 1);
+    cv::Sobel(centre, dy, CV_32F, 0, 1, 1);
+    return cv::mean(dx.mul(dx))[0] + cv::mean(dy.mul(dy))[0];
+  };
+  EXPECT_GT(gradientEnergy(undistorted) / gradientEnergy(texture), 0.85);
 }
 
 TEST(Undistortion, NoDistortionKeepsTheFrameAsItIs) {
