@@ -8,7 +8,8 @@ truth, and that the node's trajectory equals oefmt_offline's on the same bag.
 
 Private parameters: ~compressed (bool), ~rate (playback speed factor), ~frames, ~max_ate_mean [m]
 (mean absolute trajectory error after a 2-D similarity alignment), ~compare_offline (bool),
-~size (image size of the rendered flight).
+~size (image size of the rendered flight), ~seed (scene), ~simulate_args (more oefmt_simulate
+options, e.g. a lens distortion that goes into the bag's CameraInfo).
 """
 import json
 import math
@@ -74,6 +75,8 @@ class ReplayCheck(unittest.TestCase):
         # frames upscaled to the 512 working size leave frames 3-6 of this piece unregistered in
         # every mode.
         cls.size = int(rospy.get_param("~size", 512))
+        cls.seed = int(rospy.get_param("~seed", 3))
+        cls.simulate_args = str(rospy.get_param("~simulate_args", "")).split()
         # With ~mount_yaw, the camera body is mounted turned by that yaw in base_link (static
         # TF base_link -> camera_optical): the node's odometry is the offline one turned by it.
         cls.mount_yaw = float(rospy.get_param("~mount_yaw", 0.0))
@@ -86,7 +89,8 @@ class ReplayCheck(unittest.TestCase):
         # A short piece of the default circle (same speed and altitude), multi-depth scene.
         length = 491.0 * cls.frames / 200.0
         run([tool("oefmt_simulate"), "--quiet", "--track", "circle", "--length", str(length),
-             "--frames", str(cls.frames), "--size", str(cls.size), "--seed", "3", cls.flight])
+             "--frames", str(cls.frames), "--size", str(cls.size), "--seed", str(cls.seed)]
+            + cls.simulate_args + [cls.flight])
         if cls.compressed:
             run([tool("oefmt_folder_to_bag"), "--quiet", "--format", "png", cls.flight, cls.bag])
         else:
