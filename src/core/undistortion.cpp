@@ -174,7 +174,7 @@ std::string describeSizeMapping(const Intrinsics& calibration, cv::Size image_si
   const bool cropped = crop.width != calibration.width || crop.height != calibration.height;
   return source + " describes a " + sizeText({calibration.width, calibration.height}) + " camera; the " +
          sizeText(image_size) + " images are taken as its " +
-         (cropped ? "centred " + sizeText(crop) + " crop resized" : "image resized") + ": " +
+         (cropped ? "centred " + sizeText(crop) + " crop resized" : "whole image resized") + ": " +
          format("fx %.1f px, fy %.1f px, cx %.1f, cy %.1f", k.fx, k.fy, k.cx, k.cy);
 }
 
