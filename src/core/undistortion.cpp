@@ -129,8 +129,8 @@ bool viewFits(double f, const Probe& probe, cv::Point2d centre, const CameraPara
 }
 
 // Counts places where the map folds (its Jacobian determinant is not positive) and map positions
-// outside the input (beyond rounding); then clamps the in-range rounding overshoot.
-void checkMap(cv::Mat1f& map_x, cv::Mat1f& map_y, cv::Size size, long& outside, long& folded) {
+// outside the input (beyond rounding).
+void checkMap(const cv::Mat1f& map_x, const cv::Mat1f& map_y, cv::Size size, long& outside, long& folded) {
   outside = folded = 0;
   for (int v = 0; v + 1 < map_x.rows; ++v) {
     for (int u = 0; u + 1 < map_x.cols; ++u) {
@@ -142,14 +142,9 @@ void checkMap(cv::Mat1f& map_x, cv::Mat1f& map_y, cv::Size size, long& outside, 
   constexpr float kRounding = 1e-2f;  // [px] float maps versus projectPoints' doubles
   const float right = static_cast<float>(size.width - 1), bottom = static_cast<float>(size.height - 1);
   for (int v = 0; v < map_x.rows; ++v) {
-    float* x = map_x[v];
-    float* y = map_y[v];
     for (int u = 0; u < map_x.cols; ++u) {
-      if (!(x[u] >= -kRounding && y[u] >= -kRounding && x[u] <= right + kRounding && y[u] <= bottom + kRounding)) {
-        ++outside;
-      }
-      x[u] = std::clamp(x[u], 0.0f, right);
-      y[u] = std::clamp(y[u], 0.0f, bottom);
+      const float x = map_x(v, u), y = map_y(v, u);
+      if (!(x >= -kRounding && y >= -kRounding && x <= right + kRounding && y <= bottom + kRounding)) ++outside;
     }
   }
 }
@@ -196,21 +191,27 @@ CameraParameters pinholeCamera(double fx, cv::Size image_size) {
   return camera;
 }
 
-Undistorter::Undistorter(const CameraParameters& camera, cv::Size image_size, const std::string& source)
+Undistorter::Undistorter(const CameraParameters& camera, cv::Size image_size, int working_size,
+                         const std::string& source)
     : image_size_(image_size), source_(source), calibration_(camera) {
   try {
-    setUp();
+    setUp(working_size);
   } catch (const InputError& e) {
     throw InputError(source_ + ": " + e.what());
   }
 }
 
-void Undistorter::setUp() {
+void Undistorter::setUp(int working_size) {
   if (image_size_.width <= 0 || image_size_.height <= 0) throw InputError("the image size must be > 0");
+  if (working_size <= 0) throw InputError("the working size must be > 0");
   requireFinite(calibration_.distortion);
   input_.intrinsics = mapToImage(calibration_.intrinsics, image_size_);
   input_.distortion = calibration_.distortion;
   output_ = input_.intrinsics;
+  // What the core makes of a frame: its centred square, resized to the working size.
+  const int side = std::min(image_size_.width, image_size_.height);
+  const double scale = static_cast<double>(working_size) / side;
+  working_fx_ = output_.fx * scale;
   if (!input_.distortion.any()) return;
 
   const Intrinsics& k = input_.intrinsics;
@@ -219,13 +220,15 @@ void Undistorter::setUp() {
     throw InputError(lens + ": the principal point " + format("(%.1f, %.1f)", k.cx, k.cy, 0.0, 0.0) +
                      " lies outside the " + sizeText(image_size_) + " image");
   }
-  // Square pixels and the principal point at the centre: what the registration assumes.
-  const cv::Point2d centre((image_size_.width - 1) / 2.0, (image_size_.height - 1) / 2.0);
-  const double f_lens = std::sqrt(k.fx * k.fy);
-  const Probe probe = makeProbe(image_size_, centre);
-  double f = f_lens;
+  // The working frame: square pixels and the principal point at the centre, what the
+  // registration assumes.
+  const cv::Size working(working_size, working_size);
+  const cv::Point2d centre((working_size - 1) / 2.0, (working_size - 1) / 2.0);
+  lens_fx_ = std::sqrt(k.fx * k.fy) * scale;
+  const Probe probe = makeProbe(working, centre);
+  double f = lens_fx_;
   if (!viewFits(f, probe, centre, input_, image_size_)) {
-    double narrow = kMaxZoom * f_lens, wide = f_lens;
+    double narrow = kMaxZoom * lens_fx_, wide = lens_fx_;
     if (!viewFits(narrow, probe, centre, input_, image_size_)) {
       throw InputError(lens + " cannot be undone over the " + sizeText(image_size_) +
                        " image: even the central half of the view maps outside it or folds over "
@@ -239,13 +242,12 @@ void Undistorter::setUp() {
     }
     f = narrow;
   }
-  output_.fx = output_.fy = f;
-  output_.cx = centre.x;
-  output_.cy = centre.y;
+  output_ = Intrinsics{f, f, centre.x, centre.y, working_size, working_size};
+  working_fx_ = f;
 
   cv::Mat map_x, map_y;
   cv::initUndistortRectifyMap(cameraMatrix(k), input_.distortion.coefficients(), cv::noArray(),
-                              cameraMatrix(output_), image_size_, CV_32FC1, map_x, map_y);
+                              cameraMatrix(output_), working, CV_32FC1, map_x, map_y);
   cv::Mat1f mx = map_x, my = map_y;
   long outside = 0, folded = 0;
   checkMap(mx, my, image_size_, outside, folded);
@@ -254,27 +256,60 @@ void Undistorter::setUp() {
                      std::to_string(outside) + " pixels would come from outside it and " +
                      std::to_string(folded) + " from where the lens model folds over");
   }
+  // Only the part of the frame the working frame samples is converted (and shrunk): its
+  // bounding box, with the bicubic kernel's reach.
+  double x_min = 0.0, x_max = 0.0, y_min = 0.0, y_max = 0.0;
+  cv::minMaxLoc(mx, &x_min, &x_max);
+  cv::minMaxLoc(my, &y_min, &y_max);
+  const int x0 = std::max(0, static_cast<int>(std::floor(x_min)) - 2);
+  const int y0 = std::max(0, static_cast<int>(std::floor(y_min)) - 2);
+  const int x1 = std::min(image_size_.width, static_cast<int>(std::ceil(x_max)) + 3);
+  const int y1 = std::min(image_size_.height, static_cast<int>(std::ceil(y_max)) + 3);
+  roi_ = cv::Rect(x0, y0, x1 - x0, y1 - y0);
+  // A frame larger than the working scale is shrunk first by area interpolation (as
+  // prepareImage shrinks an undistorted one), so the remap neither aliases nor costs more than
+  // the working size.
+  double sx = 1.0, sy = 1.0;
+  cv::Size source = roi_.size();
+  if (scale < 1.0) {
+    reduced_ = cv::Size(std::max(1, static_cast<int>(std::lround(roi_.width * scale))),
+                        std::max(1, static_cast<int>(std::lround(roi_.height * scale))));
+    sx = static_cast<double>(reduced_.width) / roi_.width;
+    sy = static_cast<double>(reduced_.height) / roi_.height;
+    source = reduced_;
+  }
+  const float right = static_cast<float>(source.width - 1), bottom = static_cast<float>(source.height - 1);
+  for (int v = 0; v < mx.rows; ++v) {
+    for (int u = 0; u < mx.cols; ++u) {
+      // Pixel centres at integer coordinates: a resize by s maps x to (x + 0.5) s - 0.5.
+      mx(v, u) = std::clamp(static_cast<float>((mx(v, u) - x0 + 0.5) * sx - 0.5), 0.0f, right);
+      my(v, u) = std::clamp(static_cast<float>((my(v, u) - y0 + 0.5) * sy - 0.5), 0.0f, bottom);
+    }
+  }
   cv::convertMaps(mx, my, map_xy_, map_fraction_, CV_16SC2);
 
-  // The horizontal field of view kept, for describe(): the input's along its middle row.
-  std::vector<cv::Point2d> ends{{0.0, k.cy}, {image_size_.width - 1.0, k.cy}}, normalised;
+  // The horizontal field of view kept, for describe(): the lens's over the square's middle row.
+  const double left = (image_size_.width - side) / 2.0;
+  std::vector<cv::Point2d> ends{{left, k.cy}, {left + side - 1.0, k.cy}}, normalised;
   cv::undistortPoints(ends, normalised, cameraMatrix(k), input_.distortion.coefficients());
-  const double input_width = normalised[1].x - normalised[0].x;
-  kept_width_ = input_width > 0.0 ? (image_size_.width - 1) / output_.fx / input_width : 1.0;
+  const double lens_width = (normalised[1].x - normalised[0].x) * side / (side - 1.0);
+  kept_width_ = lens_width > 0.0 ? working_size / output_.fx / lens_width : 1.0;
 }
 
-double Undistorter::workingFx(int size) const {
-  return output_.fx * size / std::min(image_size_.width, image_size_.height);
-}
-
-cv::Mat Undistorter::apply(const cv::Mat& image) const {
+cv::Mat Undistorter::apply(const cv::Mat& image, ChannelOrder order) const {
   if (!remaps()) return image;
   if (image.size() != image_size_) {
     throw InputError("the frame is " + sizeText(image.size()) + " but the undistortion was set up for " +
                      sizeText(image_size_) + " frames");
   }
-  cv::Mat undistorted;
-  cv::remap(image, undistorted, map_xy_, map_fraction_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  cv::Mat1f grey = toGreyFloat(image(roi_), order);
+  if (!reduced_.empty()) {
+    cv::Mat1f shrunk;
+    cv::resize(grey, shrunk, reduced_, 0.0, 0.0, cv::INTER_AREA);
+    grey = shrunk;
+  }
+  cv::Mat1f undistorted;
+  cv::remap(grey, undistorted, map_xy_, map_fraction_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   return undistorted;
 }
 
@@ -288,10 +323,16 @@ std::vector<std::string> Undistorter::notes() const {
 
 std::string Undistorter::describe() const {
   if (!remaps()) return "no lens distortion: frames used as they are";
-  return "undistorting (" + source_ + ": " + input_.distortion.text() + "): " + sizeText(image_size_) +
-         format(" frames with fx = fy %.1f px (the lens's %.1f), principal point at the centre, "
-                "%.0f %% of the lens's horizontal field of view",
-                output_.fx, std::sqrt(input_.intrinsics.fx * input_.intrinsics.fy), 100.0 * kept_width_, 0.0);
+  const int side = std::min(image_size_.width, image_size_.height);
+  const std::string from = image_size_.width == image_size_.height
+                               ? ""
+                               : " from the " + sizeText(image_size_) + " frames' centred " +
+                                     sizeText({side, side}) + " square";
+  return "undistorting (" + source_ + ": " + input_.distortion.text() + "): " +
+         sizeText({output_.width, output_.height}) + " working frames" + from + ", " +
+         format("fx = fy %.1f px (the lens's %.1f), principal point at the centre, %.0f %% of the "
+                "lens's horizontal field of view",
+                output_.fx, lens_fx_, 100.0 * kept_width_, 0.0);
 }
 
 }  // namespace oefmt

@@ -286,8 +286,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
   }
   // Working-image focal length: the core crops to a square and resizes to N. Without camera
   // intrinsics, the YAML's own (working-image) fx is the last resort.
-  const double working_fx =
-      undistorter_ ? undistorter_->workingFx(estimator_config_.registration.size) : estimator_config_.fx;
+  const double working_fx = undistorter_ ? undistorter_->workingFx() : estimator_config_.fx;
   if (!(working_fx > 0.0)) {
     ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": no intrinsics: publish "
                                                  << nh_.resolveName("camera_info")
@@ -394,7 +393,8 @@ void OdometryRos::updateUndistorter(const CameraParameters& calibration, const s
   // Set up once per calibration and image size (the maps take a few milliseconds).
   undistorter_.reset();
   try {
-    undistorter_ = std::make_unique<const Undistorter>(calibration, image_size, source);
+    undistorter_ = std::make_unique<const Undistorter>(calibration, image_size,
+                                                       estimator_config_.registration.size, source);
     failed_camera_.reset();
   } catch (const InputError& e) {
     failed_camera_ = FailedCamera{calibration, image_size, e.what()};

@@ -154,6 +154,7 @@ int main(int argc, char** argv) {
         options.config.empty() ? oefmt::EstimatorConfig{} : oefmt::loadConfig(options.config);
     if (!options.mode.empty()) config.mode = oefmt::parseEstimatorMode(options.mode);
     if (options.altitude > 0.0) config.altitude = options.altitude;
+    config.validate();
 
     std::unique_ptr<oefmt::FrameSource> opened =
         options.images.empty()
@@ -184,15 +185,15 @@ int main(int argc, char** argv) {
       }
       if (calibration) {
         if (!options.undistort) calibration->distortion = oefmt::Distortion{};
-        undistorter = std::make_shared<const oefmt::Undistorter>(*calibration, image_size, source);
-        config.fx = undistorter->workingFx(config.registration.size);
+        undistorter = std::make_shared<const oefmt::Undistorter>(*calibration, image_size,
+                                                                 config.registration.size, source);
+        config.fx = undistorter->workingFx();
       }
     }
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
     // one registers the previous frame. Two frames queued (A/B on the authors' circle: 2.07 s
     // vs 2.19 s with one; a second reader thread gained nothing more and cost 13 MB); each
     // frame queued costs the 3 MB of its spectra.
-    config.validate();
     if (!options.quiet) {
       const std::string notice = oefmt::fftPlanningNotice(config.registration);
       if (!notice.empty()) std::fprintf(stderr, "oefmt_offline: %s\n", notice.c_str());

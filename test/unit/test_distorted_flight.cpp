@@ -54,7 +54,7 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   EstimatorConfig config;
   config.registration.fft_planning = FftPlanning::kEstimate;
   config.altitude = plan.track.altitude;
-  config.fx = camera.workingFx(config.registration.size);
+  config.fx = camera.workingFx();
   Estimator estimator(config);
   Trajectory estimate, truth;
   FlightRun run;
@@ -116,12 +116,13 @@ TEST(DistortedFlight, UndistortedRegistersAsWellAsThePinholeFlight) {
   lens.distortion.k2 = 0.05;
   const cv::Size size(plan.camera.intrinsics.width, plan.camera.intrinsics.height);
 
-  const FlightRun pinhole = fly(plan, render(plan, scene, plan.camera), Undistorter(plan.camera, size));
+  const int n = EstimatorConfig{}.registration.size;
+  const FlightRun pinhole = fly(plan, render(plan, scene, plan.camera), Undistorter(plan.camera, size, n));
   const std::vector<cv::Mat1b> distorted = render(plan, scene, lens);
-  const FlightRun undistorted = fly(plan, distorted, Undistorter(lens, size));
+  const FlightRun undistorted = fly(plan, distorted, Undistorter(lens, size, n));
   CameraParameters ignored = lens;
   ignored.distortion = Distortion{};
-  const FlightRun as_they_are = fly(plan, distorted, Undistorter(ignored, size));
+  const FlightRun as_they_are = fly(plan, distorted, Undistorter(ignored, size, n));
 
   EXPECT_LT(pinhole.result.ate.mean, 0.2) << "the pinhole flight itself registers";
   EXPECT_TRUE(registersAsWell(undistorted, pinhole));
