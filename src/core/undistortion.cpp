@@ -52,7 +52,11 @@ Intrinsics mapToImage(Intrinsics calibration, cv::Size image_size) {
     calibration.width = image_size.width;
     calibration.height = image_size.height;
   }
-  return intrinsicsForImageSize(calibration, image_size);
+  const Intrinsics mapped = intrinsicsForImageSize(calibration, image_size);
+  if (!(std::isfinite(mapped.fx) && std::isfinite(mapped.fy) && std::isfinite(mapped.cx) && std::isfinite(mapped.cy))) {
+    throw InputError("camera intrinsics are out of range for the " + sizeText(image_size) + " images");
+  }
+  return mapped;
 }
 
 cv::Matx33d cameraMatrix(const Intrinsics& k) { return {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0}; }

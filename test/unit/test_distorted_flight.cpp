@@ -7,9 +7,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <vector>
 
+#include "oefmt/error.h"
 #include "oefmt/estimator.h"
 #include "oefmt/evaluation.h"
 #include "oefmt/sim/flight.h"
@@ -82,7 +84,12 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   }
   EvaluationOptions options;
   options.association = AssociationMode::kIndex;
-  run.result = evaluateTrajectory(estimate, truth, options);
+  try {
+    run.result = evaluateTrajectory(estimate, truth, options);
+  } catch (const InputError&) {
+    // Nothing registered (every pose at the origin): as bad as it gets.
+    run.result.ate.mean = run.result.drift_percent = std::numeric_limits<double>::infinity();
+  }
   return run;
 }
 
