@@ -75,7 +75,8 @@ class Undistorter {
 
   /// The working frame (see the class), or `image` itself when remaps() is false. Any 1/3/4
   /// channel 8/16-bit or float frame (toGreyFloat's, in `order`). Throws InputError when
-  /// remapping a frame of another size than imageSize(). Thread-safe.
+  /// remapping a frame of another size than imageSize() or one too small to register
+  /// (requireRegistrableSize). Thread-safe.
   cv::Mat apply(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr) const;
 
   /// What to tell the user, one line each: how a calibration of another resolution is mapped

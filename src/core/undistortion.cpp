@@ -109,7 +109,8 @@ Probe makeProbe(cv::Size size, cv::Point2d centre) {
 }
 
 bool inside(const cv::Point2d& p, cv::Size size) {
-  // Bilinear sampling needs the pixel and its right/lower neighbour (weight 0 on the last one).
+  // Pixel centres span [0, size - 1]; the bicubic kernel's reach beyond the last one reads the
+  // edge pixels replicated (BORDER_REPLICATE), still the image's own values.
   return p.x >= 0.0 && p.y >= 0.0 && p.x <= size.width - 1 && p.y <= size.height - 1;
 }
 
@@ -302,6 +303,8 @@ void Undistorter::setUp(int working_size) {
 
 cv::Mat Undistorter::apply(const cv::Mat& image, ChannelOrder order) const {
   if (!remaps()) return image;
+  // The working frame would hide a frame too small to register: refused as prepareImage does.
+  requireRegistrableSize(image);
   if (image.size() != image_size_) {
     throw InputError("the frame is " + sizeText(image.size()) + " but the undistortion was set up for " +
                      sizeText(image_size_) + " frames");

@@ -316,7 +316,11 @@ BagImageReader::BagImageReader(const std::string& path, const std::string& image
     for (const rosbag::MessageInstance& message : infos) {
       const auto info = message.instantiate<sensor_msgs::CameraInfo>();
       if (!info) continue;
-      s.camera = cameraFromInfo(*info);
+      try {
+        s.camera = cameraFromInfo(*info);
+      } catch (const BagError& e) {
+        throw BagError("bag '" + path + "', " + s.info_topic + ": " + e.what());
+      }
       s.has_camera = true;
       break;
     }

@@ -295,6 +295,25 @@ TEST(BagIo, CameraInfoDistortionModels) {
   expectBagError([&] { cameraFromInfo(info); }, "not finite");
 }
 
+// A bag whose CameraInfo cannot be used stops oefmt_offline's reader at once, naming the bag,
+// the topic and the problem.
+TEST(BagIo, UnusableCameraInfoIsNamedWithItsTopic) {
+  TempDir dir;
+  {
+    rosbag::Bag bag(dir / "fisheye.bag", rosbag::bagmode::Write);
+    bag.write("/cam/image", ros::Time(1.0), imageMessage(cv::Mat1b(64, 64, static_cast<unsigned char>(1)), 1.0, "c"));
+    CameraParameters camera;
+    camera.intrinsics = {50.0, 50.0, 31.5, 31.5, 64, 64};
+    sensor_msgs::CameraInfo info = cameraInfoMessage(camera, 1.0, "c");
+    info.distortion_model = "equidistant";
+    info.D = {0.1, 0.01, 0.0, 0.0};
+    bag.write("/cam/camera_info", ros::Time(1.0), info);
+  }
+  expectBagError([&] { BagImageReader(dir / "fisheye.bag"); },
+                 "fisheye.bag', /cam/camera_info: CameraInfo distortion model 'equidistant' is not supported");
+  EXPECT_FALSE(BagImageReader(dir / "fisheye.bag", "", "-").hasCamera());  // intrinsics ignored
+}
+
 TEST(BagIo, SimulatorBagCarriesTheFlightsCamera) {
   TempDir dir;
   sim::FlightOptions options;

@@ -255,6 +255,9 @@ TEST(Undistortion, UndistortsEveryPixelTypeAndRefusesAnotherSize) {
     EXPECT_NEAR(high, value, 1e-5 * value) << type;
   }
   EXPECT_THROW(undistorter.apply(cv::Mat1b(240, 300)), InputError);
+  // A frame too small to register stays refused, though its working frame would be large.
+  const Undistorter tiny(scaled(lens(-0.2, 0.05), 0.125), {40, 30}, 128);
+  EXPECT_THROW(tiny.apply(cv::Mat1b(30, 40, static_cast<unsigned char>(9))), InputError);
 }
 
 TEST(Undistortion, CalibrationOfAnotherResolutionIsMappedAndSaidSo) {
