@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Arbitrary bytes as a file -> readCameraParameters (a dataset's cam_param.yaml) and loadConfig
-// (the estimator's YAML). Both must either return checked values or throw their documented
-// exception (DatasetError / InputError); anything else escaping (cv::Exception, bad_alloc, ...)
-// terminates the run and is a finding. An accepted configuration must survive a round trip
+// Arbitrary bytes as a file -> readCameraParameters (a dataset's cam_param.yaml), the frames'
+// undistortion set up from what it accepted, and loadConfig (the estimator's YAML). Each must
+// either return checked values or throw its documented exception (DatasetError / InputError);
+// anything else escaping (cv::Exception, bad_alloc, ...) terminates the run and is a finding. An accepted configuration must survive a round trip
 // through configToYaml. OpenCV 4.6's YAML reader never returns on some malformed documents
 // (" e: 5\nabc-\n\n", "---e:x\nlt\n-\n"): scripts/hardening.sh runs this target in fork mode and
 // tells such timeouts (stack inside cv::FileStorage) from hangs of ours.
@@ -19,6 +19,7 @@
 #include "oefmt/dataset.h"
 #include "oefmt/error.h"
 #include "oefmt/estimator_config.h"
+#include "oefmt/undistortion.h"
 
 namespace {
 
@@ -44,7 +45,18 @@ void fuzzCameraParameters(const std::string& path) {
     check(k.fx > 0.0 && k.fy > 0.0, "fx and fy > 0", k.fx);
     check(k.width >= 0 && k.height >= 0, "width and height >= 0", k.width);
     const oefmt::Distortion& d = camera.distortion;
-    for (double v : {d.k1, d.k2, d.p1, d.p2}) checkFinite(v, "distortion finite");
+    for (double v : {d.k1, d.k2, d.p1, d.p2, d.k3, d.k4, d.k5, d.k6}) checkFinite(v, "distortion finite");
+    // Any accepted calibration, on small frames (a set-up costs its search): a working frame of
+    // finite values from inside the frame, or InputError.
+    const cv::Size size(k.width > 0 && k.width <= 96 ? k.width : 80, k.height > 0 && k.height <= 96 ? k.height : 60);
+    const oefmt::Undistorter undistorter(camera, size, 64, "cam_param.yaml");
+    const cv::Mat out = undistorter.apply(cv::Mat1b(size, 128));
+    check(out.cols > 0 && out.rows > 0, "a working frame");
+    double low = 0.0, high = 0.0;
+    cv::minMaxLoc(out.reshape(1), &low, &high);
+    const double expected = undistorter.remaps() ? 128.0 / 255.0 : 128.0;  // grey float, or as given
+    check(std::fabs(low - expected) < 1e-4 && std::fabs(high - expected) < 1e-4, "uniform stays uniform", low);
+    checkFinite(undistorter.workingFx(), "working fx finite");
   } catch (const oefmt::DatasetError&) {
   } catch (const oefmt::InputError&) {
   }

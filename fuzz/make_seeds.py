@@ -84,6 +84,12 @@ Camera.width: 4056
 Camera.height: 3040""")
     write("fuzz_cam_param", "cam_param_no_header.yaml",
           b"Camera.fx: 500\nCamera.fy: 500\nCamera.cx: 320\nCamera.cy: 240\n")
+    # Lenses for the undistortion: a rational one of the images' size, and one that folds over.
+    write("fuzz_cam_param", "lens_rational.yaml",
+          b"Camera.fx: 60\nCamera.fy: 61\nCamera.cx: 40.5\nCamera.cy: 29\nCamera.k1: -0.3\n"
+          b"Camera.k2: 0.1\nCamera.k3: 0.01\nCamera.k4: 0.05\nCamera.width: 80\nCamera.height: 60\n")
+    write("fuzz_cam_param", "lens_folding.yaml",
+          b"Camera.fx: 60\nCamera.fy: 60\nCamera.cx: 40\nCamera.cy: 30\nCamera.k1: -5\n")
     write("fuzz_cam_param", "config.yaml", b"""%YAML 1.0
 ---
 mode: efmt

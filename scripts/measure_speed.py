@@ -8,7 +8,7 @@ minute to the next, and steal is the part of that the guest can see. Every run i
 summary gives the median over all runs and over the runs in which the hypervisor took less than
 --max-steal of the CPUs' time.
 
-  scripts/measure_speed.py --runs 10 --images ../shared/datasets/circle
+  scripts/measure_speed.py --runs 10 --images ../shared/datasets/circle --no-undistort
 """
 import argparse
 import os

@@ -20,13 +20,27 @@ class DatasetError : public std::runtime_error {
   explicit DatasetError(const std::string& what) : std::runtime_error(what) {}
 };
 
-/// Radial-tangential (OpenCV / ROS "plumb_bob") distortion of normalised image coordinates.
+/// Radial-tangential distortion of normalised image coordinates in OpenCV's model: ROS
+/// "plumb_bob" (k1, k2, p1, p2, k3) and, with k4..k6, "rational_polynomial" (radial factor
+/// (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6)).
 struct Distortion {
   double k1 = 0.0;
   double k2 = 0.0;
   double p1 = 0.0;
   double p2 = 0.0;
-  bool any() const { return k1 != 0.0 || k2 != 0.0 || p1 != 0.0 || p2 != 0.0; }
+  double k3 = 0.0;
+  double k4 = 0.0;
+  double k5 = 0.0;
+  double k6 = 0.0;
+  bool any() const {
+    return k1 != 0.0 || k2 != 0.0 || p1 != 0.0 || p2 != 0.0 || k3 != 0.0 || rational();
+  }
+  /// True when the rational model's denominator is used (k4, k5 or k6 non-zero).
+  bool rational() const { return k4 != 0.0 || k5 != 0.0 || k6 != 0.0; }
+  /// OpenCV's coefficient vector: (k1, k2, p1, p2, k3), plus (k4, k5, k6) when rational().
+  std::vector<double> coefficients() const;
+  /// "k1 -0.2 k2 0.05" (the non-zero coefficients; "none" when there are none).
+  std::string text() const;
 };
 
 /// Pinhole intrinsics plus distortion, in pixels of the image of intrinsics.width x height.
@@ -36,11 +50,14 @@ struct CameraParameters {
 };
 
 /// Reads the authors' cam_param.yaml (parseYaml; "%YAML:1.0" header optional) with Camera.fx, fy,
-/// cx, cy (required) and Camera.k1, k2, p1, p2, width, height (optional; missing distortion is 0,
-/// missing size is 0). Throws DatasetError naming the file and the missing or invalid key.
+/// cx, cy (required) and Camera.k1, k2, p1, p2, k3, k4, k5, k6, width, height (optional; missing
+/// distortion is 0, missing size is 0). Camera.type, when given, must be "PinHole" (the model
+/// above; ORB-SLAM's "KannalaBrandt8" fisheye is refused). Throws DatasetError naming the file and
+/// the missing or invalid key.
 CameraParameters readCameraParameters(const std::string& path);
 
-/// Writes `camera` in the same layout (all ten Camera.* keys). Throws DatasetError on failure.
+/// Writes `camera` in the same layout (the ten Camera.* keys of the authors' file, plus k3..k6 when
+/// they are not zero). Throws DatasetError on failure.
 void writeCameraParameters(const std::string& path, const CameraParameters& camera);
 
 /// Intrinsics of an image of image_size made from a camera of camera.width x height by a centred

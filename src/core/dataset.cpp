@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 
 #include "oefmt/error.h"
@@ -83,11 +84,33 @@ bool isImageFile(const fs::path& path) {
          ext == ".bmp";
 }
 
+// "PinHole" as the authors (and ORB-SLAM) write it; case and quotes are not significant.
+bool isPinhole(std::string type) {
+  std::transform(type.begin(), type.end(), type.begin(), [](unsigned char c) { return std::tolower(c); });
+  return type == "pinhole";
+}
+
 std::string sizeText(cv::Size size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
 }  // namespace
+
+std::vector<double> Distortion::coefficients() const {
+  std::vector<double> c{k1, k2, p1, p2, k3};
+  if (rational()) c.insert(c.end(), {k4, k5, k6});
+  return c;
+}
+
+std::string Distortion::text() const {
+  std::ostringstream out;
+  const std::pair<const char*, double> named[] = {{"k1", k1}, {"k2", k2}, {"p1", p1}, {"p2", p2},
+                                                  {"k3", k3}, {"k4", k4}, {"k5", k5}, {"k6", k6}};
+  for (const auto& [name, value] : named) {
+    if (value != 0.0) out << (out.tellp() > 0 ? " " : "") << name << ' ' << value;
+  }
+  return out.tellp() > 0 ? out.str() : "none";
+}
 
 CameraParameters readCameraParameters(const std::string& path) {
   YamlNode root;
@@ -106,11 +129,20 @@ CameraParameters readCameraParameters(const std::string& path) {
   k.height = static_cast<int>(std::lround(readNumber(root, path, "height", false, 0.0)));
   if (!(k.fx > 0.0 && k.fy > 0.0)) throw DatasetError("'" + path + "': Camera.fx and fy must be > 0");
   if (k.width < 0 || k.height < 0) throw DatasetError("'" + path + "': negative Camera.width/height");
+  const YamlNode* type = root.find("Camera.type");
+  if (type != nullptr && !type->is_null && !type->is_map && !isPinhole(type->scalar)) {
+    throw DatasetError("'" + path + "': Camera.type '" + type->scalar +
+                       "' is not supported (PinHole: k1, k2, p1, p2, k3 and rational k4, k5, k6)");
+  }
   Distortion& d = camera.distortion;
   d.k1 = readNumber(root, path, "k1", false, 0.0);
   d.k2 = readNumber(root, path, "k2", false, 0.0);
   d.p1 = readNumber(root, path, "p1", false, 0.0);
   d.p2 = readNumber(root, path, "p2", false, 0.0);
+  d.k3 = readNumber(root, path, "k3", false, 0.0);
+  d.k4 = readNumber(root, path, "k4", false, 0.0);
+  d.k5 = readNumber(root, path, "k5", false, 0.0);
+  d.k6 = readNumber(root, path, "k6", false, 0.0);
   return camera;
 }
 
@@ -123,7 +155,13 @@ void writeCameraParameters(const std::string& path, const CameraParameters& came
   out << "%YAML:1.0\n\nCamera.type: \"PinHole\"\n\n"
       << "Camera.fx: " << k.fx << "\nCamera.fy: " << k.fy << "\nCamera.cx: " << k.cx
       << "\nCamera.cy: " << k.cy << "\n\nCamera.k1: " << d.k1 << "\nCamera.k2: " << d.k2
-      << "\nCamera.p1: " << d.p1 << "\nCamera.p2: " << d.p2 << "\n\nCamera.width: " << k.width
+      << "\nCamera.p1: " << d.p1 << "\nCamera.p2: " << d.p2 << "\n";
+  // The authors' file has no k3..k6: written only when they carry something.
+  const std::pair<const char*, double> higher[] = {{"k3", d.k3}, {"k4", d.k4}, {"k5", d.k5}, {"k6", d.k6}};
+  for (const auto& [name, value] : higher) {
+    if (value != 0.0) out << "Camera." << name << ": " << value << "\n";
+  }
+  out << "\nCamera.width: " << k.width
       << "\nCamera.height: " << k.height << "\n";
   if (!out) throw DatasetError("cannot write camera parameters '" + path + "'");
 }

@@ -179,8 +179,13 @@ sensor_msgs::CameraInfo cameraInfoMessage(const CameraParameters& camera, double
   info.header.frame_id = frame_id;
   info.width = static_cast<std::uint32_t>(k.width);
   info.height = static_cast<std::uint32_t>(k.height);
-  info.distortion_model = sensor_msgs::distortion_models::PLUMB_BOB;
-  info.D = {d.k1, d.k2, d.p1, d.p2, 0.0};
+  if (d.rational()) {
+    info.distortion_model = sensor_msgs::distortion_models::RATIONAL_POLYNOMIAL;
+    info.D = {d.k1, d.k2, d.p1, d.p2, d.k3, d.k4, d.k5, d.k6};
+  } else {
+    info.distortion_model = sensor_msgs::distortion_models::PLUMB_BOB;
+    info.D = {d.k1, d.k2, d.p1, d.p2, d.k3};
+  }
   info.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
   info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
   info.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
@@ -197,9 +202,30 @@ CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info) {
   k.width = static_cast<int>(info.width);
   k.height = static_cast<int>(info.height);
   if (!(k.fx > 0.0 && k.fy > 0.0)) throw BagError("CameraInfo has no calibration (K is zero)");
-  if (!info.D.empty() && info.distortion_model != sensor_msgs::distortion_models::PLUMB_BOB &&
-      info.distortion_model != "rational_polynomial") {
-    throw BagError("CameraInfo distortion model '" + info.distortion_model + "' is not supported (plumb_bob)");
+  if (!(std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy))) {
+    throw BagError("CameraInfo K is not finite");
+  }
+  for (double d : info.D) {
+    if (!std::isfinite(d)) throw BagError("CameraInfo distortion coefficients (D) are not finite");
+  }
+  const bool any = std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; });
+  // OpenCV's coefficient order: k1 k2 p1 p2 k3 (plumb_bob), then k4 k5 k6 (rational_polynomial).
+  std::size_t count = 0;
+  if (info.distortion_model == sensor_msgs::distortion_models::PLUMB_BOB) {
+    count = 5;
+  } else if (info.distortion_model == sensor_msgs::distortion_models::RATIONAL_POLYNOMIAL) {
+    count = 8;
+  } else if (!info.distortion_model.empty() || any) {
+    // A fisheye ("equidistant") or other model is not a pinhole: refused rather than misread.
+    // An empty model is fine without coefficients (uncalibrated drivers publish that).
+    throw BagError("CameraInfo distortion model '" + info.distortion_model +
+                   "' is not supported (plumb_bob, rational_polynomial)");
+  }
+  for (std::size_t i = count; i < info.D.size(); ++i) {
+    if (info.D[i] != 0.0) {
+      throw BagError("CameraInfo has " + std::to_string(info.D.size()) + " distortion coefficients; " +
+                     info.distortion_model + " has " + std::to_string(count));
+    }
   }
   Distortion& d = camera.distortion;
   const auto coefficient = [&info](std::size_t i) { return i < info.D.size() ? info.D[i] : 0.0; };
@@ -207,6 +233,10 @@ CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info) {
   d.k2 = coefficient(1);
   d.p1 = coefficient(2);
   d.p2 = coefficient(3);
+  d.k3 = coefficient(4);
+  d.k4 = coefficient(5);
+  d.k5 = coefficient(6);
+  d.k6 = coefficient(7);
   return camera;
 }
 
@@ -286,7 +316,11 @@ BagImageReader::BagImageReader(const std::string& path, const std::string& image
     for (const rosbag::MessageInstance& message : infos) {
       const auto info = message.instantiate<sensor_msgs::CameraInfo>();
       if (!info) continue;
-      s.camera = cameraFromInfo(*info);
+      try {
+        s.camera = cameraFromInfo(*info);
+      } catch (const BagError& e) {
+        throw BagError("bag '" + path + "', " + s.info_topic + ": " + e.what());
+      }
       s.has_camera = true;
       break;
     }

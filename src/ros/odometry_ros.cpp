@@ -4,12 +4,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <sstream>
 
 #include <cv_bridge/cv_bridge.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <ros/package.h>
 #include <tf2/LinearMath/Matrix3x3.h>
@@ -22,6 +20,7 @@
 #include "oefmt/ros/estimate_messages.h"
 #include "oefmt/ros/parameter_yaml.h"
 #include "oefmt/trajectory.h"
+#include "oefmt/undistortion.h"
 
 namespace oefmt {
 namespace {
@@ -128,6 +127,7 @@ void OdometryRos::loadParameters() {
   p.input_buffer = param(private_nh_, "input_buffer", p.input_buffer);
   p.path_length = param(private_nh_, "path_length", p.path_length);
   p.camera_fx = param(private_nh_, "camera_fx", p.camera_fx);
+  p.undistort = param(private_nh_, "undistort", p.undistort);
   p.initial_altitude = param(private_nh_, "initial_altitude", p.initial_altitude);
   p.use_altitude_topic = param(private_nh_, "use_altitude_topic", p.use_altitude_topic);
   p.time_jump_tolerance = param(private_nh_, "time_jump_tolerance", p.time_jump_tolerance);
@@ -266,22 +266,27 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     info = camera_info_;
     altitude_topic = altitude_from_topic_;
   }
-  double fx = parameters_.camera_fx;
+  // The camera of the frames as registered (set up as oefmt_offline does): camera_info's
+  // calibration, or ~camera_fx, mapped to the image size, its lens distortion undone.
+  std::optional<CameraParameters> calibration;
   if (info && info->K[0] > 0.0 && info->K[4] > 0.0) {
-    fx = info->K[0];
-    if (info->width > 0 && info->height > 0 &&
-        (static_cast<int>(info->width) != image.cols || static_cast<int>(info->height) != image.rows)) {
-      ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": camera_info is for " << info->width << "x"
-                                                  << info->height << " images, the image is "
-                                                  << image.cols << "x" << image.rows
-                                                  << ": its focal length is used as it is");
+    try {
+      calibration = cameraFromInfo(*info);
+    } catch (const BagError& e) {
+      throw InputError(std::string("camera_info: ") + e.what());
     }
+    if (!parameters_.undistort) calibration->distortion = Distortion{};
+  } else if (parameters_.camera_fx > 0.0) {
+    calibration = pinholeCamera(parameters_.camera_fx, image.size());
+  }
+  if (calibration) {
+    updateUndistorter(*calibration, info ? "camera_info" : "~camera_fx", image.size());
+  } else {
+    undistorter_.reset();
   }
   // Working-image focal length: the core crops to a square and resizes to N. Without camera
   // intrinsics, the YAML's own (working-image) fx is the last resort.
-  const double working_fx = fx > 0.0
-                                ? fx * estimator_config_.registration.size / std::min(image.cols, image.rows)
-                                : estimator_config_.fx;
+  const double working_fx = undistorter_ ? undistorter_->workingFx() : estimator_config_.fx;
   if (!(working_fx > 0.0)) {
     ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": no intrinsics: publish "
                                                  << nh_.resolveName("camera_info")
@@ -367,7 +372,7 @@ void OdometryRos::process(const InputFrame& frame) {
     ++frames_rejected_;
     return;
   }
-  undistortIfNeeded(image);
+  if (undistorter_) image = undistorter_->apply(image);
   // Correlation surfaces cost copies: only while someone watches them.
   estimator_->setKeepSurfaces(rotation_zoom_publisher_.getNumSubscribers() > 0 ||
                               translation_publisher_.getNumSubscribers() > 0);
@@ -379,30 +384,24 @@ void OdometryRos::process(const InputFrame& frame) {
   publish(frame, *estimate);
 }
 
-void OdometryRos::undistortIfNeeded(cv::Mat& image) {
-  sensor_msgs::CameraInfoConstPtr info;
-  {
-    std::lock_guard<std::mutex> lock(camera_mutex_);
-    info = camera_info_;
+void OdometryRos::updateUndistorter(const CameraParameters& calibration, const std::string& source,
+                                    cv::Size image_size) {
+  if (undistorter_ && undistorter_->madeFor(calibration, image_size)) return;
+  if (failed_camera_ && failed_camera_->madeFor(calibration, image_size)) {
+    throw InputError(failed_camera_->error);  // the same calibration again: not set up again
   }
-  if (!info || info->K[0] <= 0.0) return;
-  const bool distorted = std::any_of(info->D.begin(), info->D.end(), [](double d) { return d != 0.0; });
-  if (!distorted) return;
-  // Maps are rebuilt only when the calibration or the image size changes.
-  std::ostringstream key;
-  key << image.cols << "x" << image.rows;
-  for (double k : info->K) key << ' ' << k;
-  for (double d : info->D) key << ' ' << d;
-  if (key.str() != undistort_key_) {
-    const cv::Matx33d camera(info->K[0], info->K[1], info->K[2], info->K[3], info->K[4], info->K[5],
-                             info->K[6], info->K[7], info->K[8]);
-    cv::initUndistortRectifyMap(camera, info->D, cv::noArray(), camera, image.size(), CV_16SC2,
-                                undistort_map1_, undistort_map2_);
-    undistort_key_ = key.str();
+  // Set up once per calibration and image size (the maps take a few milliseconds).
+  undistorter_.reset();
+  try {
+    undistorter_ = std::make_unique<const Undistorter>(calibration, image_size,
+                                                       estimator_config_.registration.size, source);
+    failed_camera_.reset();
+  } catch (const InputError& e) {
+    failed_camera_ = FailedCamera{calibration, image_size, e.what()};
+    ROS_ERROR_STREAM(name_ << ": " << failed_camera_->error);
+    throw;
   }
-  cv::Mat undistorted;
-  cv::remap(image, undistorted, undistort_map1_, undistort_map2_, cv::INTER_LINEAR);
-  image = undistorted;
+  for (const std::string& note : undistorter_->notes()) ROS_INFO_STREAM(name_ << ": " << note);
 }
 
 void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {

@@ -44,6 +44,20 @@ std::vector<cv::Point2d> toDouble(const std::vector<cv::Point2f>& points) {
   return std::vector<cv::Point2d>(points.begin(), points.end());
 }
 
+// OpenCV's radial factor: (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6).
+double radialFactor(const Distortion& d, double r2) {
+  // Spelled term by term, as before k3..k6 existed, so plumb_bob renders stay bit-identical.
+  const double numerator = 1.0 + d.k1 * r2 + d.k2 * r2 * r2 + d.k3 * r2 * r2 * r2;
+  const double denominator = 1.0 + d.k4 * r2 + d.k5 * r2 * r2 + d.k6 * r2 * r2 * r2;
+  return numerator / denominator;
+}
+
+cv::Point2d tangentialTerm(const Distortion& d, cv::Point2d p) {
+  const double r2 = p.x * p.x + p.y * p.y;
+  return {2.0 * d.p1 * p.x * p.y + d.p2 * (r2 + 2.0 * p.x * p.x),
+          d.p1 * (r2 + 2.0 * p.y * p.y) + 2.0 * d.p2 * p.x * p.y};
+}
+
 }  // namespace
 
 cv::Matx33d opticalToWorld(double yaw) {
@@ -55,10 +69,7 @@ cv::Matx33d opticalToWorld(double yaw) {
 }
 
 cv::Point2d distortNormalised(const Distortion& d, cv::Point2d p) {
-  const double r2 = p.x * p.x + p.y * p.y;
-  const double radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2;
-  return {p.x * radial + 2.0 * d.p1 * p.x * p.y + d.p2 * (r2 + 2.0 * p.x * p.x),
-          p.y * radial + d.p1 * (r2 + 2.0 * p.y * p.y) + 2.0 * d.p2 * p.x * p.y};
+  return p * radialFactor(d, p.x * p.x + p.y * p.y) + tangentialTerm(d, p);
 }
 
 cv::Point2d undistortNormalised(const Distortion& d, cv::Point2d distorted) {
@@ -66,11 +77,7 @@ cv::Point2d undistortNormalised(const Distortion& d, cv::Point2d distorted) {
   // p = (distorted - tangential(p)) / radial(p), iterated to its fixed point.
   cv::Point2d p = distorted;
   for (int iteration = 0; iteration < 200; ++iteration) {
-    const double r2 = p.x * p.x + p.y * p.y;
-    const double radial = 1.0 + d.k1 * r2 + d.k2 * r2 * r2;
-    const cv::Point2d tangential(2.0 * d.p1 * p.x * p.y + d.p2 * (r2 + 2.0 * p.x * p.x),
-                                 d.p1 * (r2 + 2.0 * p.y * p.y) + 2.0 * d.p2 * p.x * p.y);
-    const cv::Point2d next = (distorted - tangential) / radial;
+    const cv::Point2d next = (distorted - tangentialTerm(d, p)) / radialFactor(d, p.x * p.x + p.y * p.y);
     const cv::Point2d step = next - p;
     p = next;
     if (step.dot(step) < 1e-28) break;

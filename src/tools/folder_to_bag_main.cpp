@@ -21,7 +21,7 @@ Reads DATASET_DIR in the o-eFMT authors' layout (Images/, imageList.txt, optiona
 timestamps.txt, cam_param.yaml) and writes every image, as stored, with a CameraInfo of the same
 stamp. cam_param.yaml's intrinsics (of the original camera, e.g. 4056x3040) are scaled to the
 images' size (centred crop to their aspect, then resize) and written as CameraInfo K/P, with
-D = (k1, k2, p1, p2, 0) plumb_bob.
+D = (k1, k2, p1, p2, k3) plumb_bob (rational_polynomial with k4..k6 when cam_param.yaml has them).
 
 options:
   --image-topic T      image topic (default /camera/image_raw; /camera/image_raw/compressed

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "frame_source.h"
 
+#include <optional>
 #include <utility>
 
 #include "oefmt/error.h"
@@ -22,7 +23,11 @@ class FolderSource : public FrameSource {
     ++index_;
     return true;
   }
-  Intrinsics intrinsics() const override { return dataset_.intrinsics(); }
+  std::optional<CameraParameters> calibration() const override {
+    return CameraParameters{dataset_.fileIntrinsics(), dataset_.distortion()};
+  }
+  std::string calibrationSource() const override { return "cam_param.yaml"; }
+  cv::Size imageSize() override { return dataset_.imageSize(); }
   std::string describe() const override {
     return dataset_.directory() + " (" + std::to_string(dataset_.size()) + " images " +
            std::to_string(dataset_.imageSize().width) + "x" +
@@ -43,15 +48,31 @@ class BagSource : public FrameSource {
   std::size_t size() const override { return reader_.size(); }
   bool next(SourceFrame& frame) override {
     BagFrame bag_frame;
-    if (!reader_.next(bag_frame)) return false;
+    if (first_) {
+      bag_frame = std::move(*first_);
+      first_.reset();
+    } else if (!reader_.next(bag_frame)) {
+      return false;
+    }
     frame.index = index_++;
     frame.stamp = bag_frame.stamp;
     frame.name = reader_.imageTopic() + " message " + std::to_string(frame.index);
     frame.image = bag_frame.image;
     return true;
   }
-  Intrinsics intrinsics() const override {
-    return reader_.hasCamera() ? reader_.camera().intrinsics : Intrinsics{};
+  std::optional<CameraParameters> calibration() const override {
+    if (!reader_.hasCamera()) return std::nullopt;
+    return reader_.camera();
+  }
+  std::string calibrationSource() const override { return "CameraInfo on " + reader_.cameraInfoTopic(); }
+  cv::Size imageSize() override {
+    // The first frame is decoded now and handed out by the first next().
+    if (index_ == 0 && !first_) {
+      BagFrame frame;
+      if (!reader_.next(frame)) return {};
+      first_ = std::move(frame);
+    }
+    return first_ ? first_->image.size() : cv::Size();
   }
   std::string describe() const override {
     return path_ + " (" + std::to_string(reader_.size()) + " messages on " + reader_.imageTopic() +
@@ -61,6 +82,7 @@ class BagSource : public FrameSource {
  private:
   std::string path_;
   BagImageReader reader_;
+  std::optional<BagFrame> first_;  // read ahead by imageSize()
   std::size_t index_ = 0;
 };
 

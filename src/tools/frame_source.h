@@ -36,8 +36,14 @@ class FrameSource {
   virtual ~FrameSource() = default;
   virtual std::size_t size() const = 0;
   virtual bool next(SourceFrame& frame) = 0;
-  /// Intrinsics of the images (not of the working size); invalid when unknown.
-  virtual Intrinsics intrinsics() const = 0;
+  /// The calibration that comes with the frames (cam_param.yaml, the bag's CameraInfo) for its
+  /// own resolution (intrinsics.width/height; 0 when it gives none); nullopt when there is none.
+  virtual std::optional<CameraParameters> calibration() const { return std::nullopt; }
+  /// Where calibration() comes from, for messages ("cam_param.yaml", "CameraInfo on /c/info").
+  virtual std::string calibrationSource() const { return "the calibration"; }
+  /// Size of the frames (the first one's; a bag decodes it ahead), empty when there is none.
+  /// Called before the first next().
+  virtual cv::Size imageSize() { return {}; }
   virtual std::string describe() const = 0;
 };
 

@@ -12,6 +12,7 @@
 #include <iostream>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,14 +26,15 @@
 #include "oefmt/sim/progress.h"
 #include "oefmt/spectra.h"
 #include "oefmt/trajectory.h"
+#include "oefmt/undistortion.h"
 
 namespace {
 
 const char* const kUsage =
     "usage: oefmt_offline (--images DIR | --bag FILE [--image-topic T] [--camera-info-topic T])\n"
     "                     --output TRAJ.tum [--diagnostics FILE.csv] [--config FILE.yaml]\n"
-    "                     [--mode oefmt|efmt|fmt] [--altitude M] [--fx PX] [--max-frames N]\n"
-    "                     [--quiet]\n"
+    "                     [--mode oefmt|efmt|fmt] [--altitude M] [--fx PX] [--no-undistort]\n"
+    "                     [--max-frames N] [--quiet]\n"
     "\n"
     "  --images DIR          a folder in the o-eFMT authors' layout (Images/, imageList.txt,\n"
     "                        cam_param.yaml, optional timestamps.txt)\n"
@@ -49,6 +51,9 @@ const char* const kUsage =
     "  --altitude M          altitude above the dominant plane at the first frame [m]: metric\n"
     "                        output (otherwise units of the initial altitude)\n"
     "  --fx PX               focal length of the images [px] (overrides cam_param/CameraInfo)\n"
+    "  --no-undistort        take the images as undistorted: ignore the lens distortion of\n"
+    "                        cam_param.yaml/CameraInfo (rectified images, or renders whose\n"
+    "                        cam_param.yaml is another camera's, as the o-eFMT authors' circle)\n"
     "  --max-frames N        stop after N frames\n"
     "  --quiet               no progress bar and no summary table\n"
     "Exit status: 0 done, 1 an input could not be read (the trajectory so far is kept), 2 usage.\n";
@@ -58,6 +63,7 @@ struct Options {
   double altitude = -1.0;
   double fx = 0.0;
   long max_frames = -1;
+  bool undistort = true;
   bool quiet = false;
 };
 
@@ -86,6 +92,7 @@ Options parseArguments(int argc, char** argv) {
       else if (arg == "--mode") o.mode = value();
       else if (arg == "--altitude") o.altitude = args.number(arg);
       else if (arg == "--fx") o.fx = args.number(arg);
+      else if (arg == "--no-undistort") o.undistort = false;
       else if (arg == "--max-frames") o.max_frames = args.integer(arg);
       else if (arg == "--quiet") o.quiet = true;
       else usageError("unknown option '" + arg + "'");
@@ -149,20 +156,46 @@ int main(int argc, char** argv) {
         options.config.empty() ? oefmt::EstimatorConfig{} : oefmt::loadConfig(options.config);
     if (!options.mode.empty()) config.mode = oefmt::parseEstimatorMode(options.mode);
     if (options.altitude > 0.0) config.altitude = options.altitude;
+    config.validate();
 
     std::unique_ptr<oefmt::FrameSource> opened =
         options.images.empty()
             ? oefmt::openBag(options.bag, options.image_topic, options.camera_info_topic)
             : oefmt::openFolder(options.images);
-    // Focal length of the working image: the core crops a centred square and resizes it to N.
-    oefmt::Intrinsics intrinsics = opened->intrinsics();
-    if (options.fx > 0.0) intrinsics.fx = intrinsics.fy = options.fx;
     const std::string source_text = opened->describe();
+    const cv::Size image_size = opened->imageSize();
+    // The camera of the frames as registered: the calibration mapped to the images' size, the
+    // lens distortion undone (the node sets up the same, so both register the same frames).
+    std::shared_ptr<const oefmt::Undistorter> undistorter;
+    if (!image_size.empty()) {
+      std::optional<oefmt::CameraParameters> calibration = opened->calibration();
+      std::string source = opened->calibrationSource();
+      if (options.fx > 0.0) {
+        // --fx is the images' focal length: it replaces the calibration's (mapped to the images).
+        oefmt::CameraParameters camera = oefmt::pinholeCamera(options.fx, image_size);
+        if (calibration) {
+          const oefmt::Intrinsics& k = calibration->intrinsics;
+          if (k.width > 0 && k.height > 0) {
+            const oefmt::Intrinsics mapped = oefmt::intrinsicsForImageSize(k, image_size);
+            camera.intrinsics.cx = mapped.cx;
+            camera.intrinsics.cy = mapped.cy;
+          }
+          camera.distortion = calibration->distortion;
+        }
+        calibration = camera;
+        source = "--fx";
+      }
+      if (calibration) {
+        if (!options.undistort) calibration->distortion = oefmt::Distortion{};
+        undistorter = std::make_shared<const oefmt::Undistorter>(*calibration, image_size,
+                                                                 config.registration.size, source);
+        config.fx = undistorter->workingFx();
+      }
+    }
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
     // one registers the previous frame. Two frames queued (A/B on the authors' circle: 2.07 s
     // vs 2.19 s with one; a second reader thread gained nothing more and cost 13 MB); each
     // frame queued costs the 3 MB of its spectra.
-    config.validate();
     if (!options.quiet) {
       const std::string notice = oefmt::fftPlanningNotice(config.registration);
       if (!notice.empty()) std::fprintf(stderr, "oefmt_offline: %s\n", notice.c_str());
@@ -170,8 +203,8 @@ int main(int argc, char** argv) {
     const auto context = std::make_shared<const oefmt::SpectralContext>(config.registration);
     oefmt::PrefetchingSource source(
         std::move(opened), 2,
-        [builder = oefmt::SpectraBuilder(context)](const cv::Mat& image) mutable {
-          return builder.build(image);
+        [builder = oefmt::SpectraBuilder(context), undistorter](const cv::Mat& image) mutable {
+          return builder.build(undistorter ? undistorter->apply(image) : image);
         });
 
     trajectory.open(options.output);
@@ -183,7 +216,12 @@ int main(int argc, char** argv) {
       if (!diagnostics) throw oefmt::InputError("cannot write '" + options.diagnostics + "'");
       writeDiagnosticsHeader(diagnostics);
     }
-    if (!options.quiet) std::fprintf(stderr, "oefmt_offline: %s, mode %s\n", source_text.c_str(), oefmt::toString(config.mode));
+    if (!options.quiet) {
+      std::fprintf(stderr, "oefmt_offline: %s, mode %s\n", source_text.c_str(), oefmt::toString(config.mode));
+      if (undistorter) {
+        for (const std::string& note : undistorter->notes()) std::fprintf(stderr, "oefmt_offline: %s\n", note.c_str());
+      }
+    }
 
     std::unique_ptr<oefmt::Estimator> estimator;
     const size_t total = options.max_frames >= 0
@@ -193,10 +231,7 @@ int main(int argc, char** argv) {
     oefmt::SourceFrame frame;
     while ((options.max_frames < 0 || frames < options.max_frames) && source.next(frame)) {
       if (!estimator) {
-        if (intrinsics.valid()) {
-          config.fx = intrinsics.fx * config.registration.size /
-                      std::min(frame.image_size.width, frame.image_size.height);
-        } else if (!options.quiet) {
+        if (!undistorter && !options.quiet) {
           std::fprintf(stderr, "oefmt_offline: no intrinsics (no cam_param.yaml/CameraInfo, no "
                                "--fx): assuming a 53 degree field of view\n");
         }

@@ -54,6 +54,7 @@ camera:
   --fx PX, --fy PX           focal lengths (default: 60 deg horizontal field of view; fy = fx)
   --cx PX, --cy PX           principal point (default: image centre)
   --k1 K, --k2 K             radial distortion rendered and written to cam_param/CameraInfo
+                             (a barrel lens sees wider: without --altitude it flies lower)
 scene:
   --seed N                   scene and noise seed (default 1)
   --levels H1,H2,...         raised levels' heights [m] (default 0.15, 0.30 and 0.225 of the

@@ -2,6 +2,8 @@
 // Bag I/O: folder -> bag -> frames identical, every supported encoding, clear errors.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <fstream>
 #include <functional>
 #include <map>
@@ -252,6 +254,64 @@ TEST(BagIo, CameraInfoRoundTrip) {
   EXPECT_EQ(back.distortion.p2, 0.002);
   sensor_msgs::CameraInfo uncalibrated;
   EXPECT_THROW(cameraFromInfo(uncalibrated), BagError);
+}
+
+// The models both programs take (through OpenCV), and a clear error naming any other.
+TEST(BagIo, CameraInfoDistortionModels) {
+  CameraParameters camera;
+  camera.intrinsics = {410.5, 411.25, 255.5, 250.0, 512, 500};
+  camera.distortion.k1 = -0.3;
+  camera.distortion.k3 = 0.02;
+  sensor_msgs::CameraInfo info = cameraInfoMessage(camera, 3.0, "cam");
+  EXPECT_EQ(info.distortion_model, "plumb_bob");
+  EXPECT_EQ(cameraFromInfo(info).distortion.k3, 0.02);
+  camera.distortion.k4 = 0.1;
+  camera.distortion.k6 = -0.01;
+  info = cameraInfoMessage(camera, 3.0, "cam");
+  EXPECT_EQ(info.distortion_model, "rational_polynomial");
+  ASSERT_EQ(info.D.size(), 8u);
+  const CameraParameters rational = cameraFromInfo(info);
+  EXPECT_EQ(rational.distortion.k4, 0.1);
+  EXPECT_EQ(rational.distortion.k6, -0.01);
+  // Uncalibrated drivers: no model, no (or zero) coefficients.
+  info.distortion_model = "";
+  info.D.clear();
+  EXPECT_FALSE(cameraFromInfo(info).distortion.any());
+  info.D = {0.0, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_FALSE(cameraFromInfo(info).distortion.any());
+  // A fisheye is not a pinhole, even without coefficients.
+  info.distortion_model = "equidistant";
+  expectBagError([&] { cameraFromInfo(info); }, "distortion model 'equidistant' is not supported");
+  info.D.clear();
+  expectBagError([&] { cameraFromInfo(info); }, "'equidistant'");
+  info.distortion_model = "";
+  info.D = {-0.1, 0.0, 0.0, 0.0, 0.0};
+  expectBagError([&] { cameraFromInfo(info); }, "distortion model '' is not supported");
+  // plumb_bob has five coefficients: more (non-zero) ones would be dropped silently.
+  info.distortion_model = "plumb_bob";
+  info.D = {-0.1, 0.0, 0.0, 0.0, 0.0, 0.3};
+  expectBagError([&] { cameraFromInfo(info); }, "6 distortion coefficients; plumb_bob has 5");
+  info.D = {-0.1, std::nan(""), 0.0, 0.0, 0.0};
+  expectBagError([&] { cameraFromInfo(info); }, "not finite");
+}
+
+// A bag whose CameraInfo cannot be used stops oefmt_offline's reader at once, naming the bag,
+// the topic and the problem.
+TEST(BagIo, UnusableCameraInfoIsNamedWithItsTopic) {
+  TempDir dir;
+  {
+    rosbag::Bag bag(dir / "fisheye.bag", rosbag::bagmode::Write);
+    bag.write("/cam/image", ros::Time(1.0), imageMessage(cv::Mat1b(64, 64, static_cast<unsigned char>(1)), 1.0, "c"));
+    CameraParameters camera;
+    camera.intrinsics = {50.0, 50.0, 31.5, 31.5, 64, 64};
+    sensor_msgs::CameraInfo info = cameraInfoMessage(camera, 1.0, "c");
+    info.distortion_model = "equidistant";
+    info.D = {0.1, 0.01, 0.0, 0.0};
+    bag.write("/cam/camera_info", ros::Time(1.0), info);
+  }
+  expectBagError([&] { BagImageReader(dir / "fisheye.bag"); },
+                 "fisheye.bag', /cam/camera_info: CameraInfo distortion model 'equidistant' is not supported");
+  EXPECT_FALSE(BagImageReader(dir / "fisheye.bag", "", "-").hasCamera());  // intrinsics ignored
 }
 
 TEST(BagIo, SimulatorBagCarriesTheFlightsCamera) {

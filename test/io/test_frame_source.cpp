@@ -31,7 +31,6 @@ class CountingSource : public FrameSource {
     if (read_ != nullptr) ++*read_;
     return true;
   }
-  Intrinsics intrinsics() const override { return Intrinsics{}; }
   std::string describe() const override { return "counting"; }
 
  private:

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -202,6 +203,94 @@ TEST(Tools, OfflineKeepsTheTrajectoryOnBadInput) {
                                        " --output " + (dir / "none.tum"));
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("nowhere"), std::string::npos) << missing.err;
+}
+
+// The poses (x y z qx qy qz qw) of a TUM file, without the stamps.
+std::vector<std::vector<double>> poses(const std::string& path) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream text(readFile(path));
+  std::string line;
+  while (std::getline(text, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double stamp = 0.0;
+    std::vector<double> pose(7);
+    fields >> stamp;
+    for (double& value : pose) fields >> value;
+    rows.push_back(pose);
+  }
+  return rows;
+}
+
+// Largest difference between two trajectories' poses (infinite when their lengths differ).
+double largestDifference(const std::vector<std::vector<double>>& a, const std::vector<std::vector<double>>& b) {
+  if (a.size() != b.size()) return HUGE_VAL;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < a[i].size(); ++j) largest = std::max(largest, std::fabs(a[i][j] - b[i][j]));
+  }
+  return largest;
+}
+
+// A folder's cam_param.yaml and a bag's CameraInfo set up the same undistortion: the same poses
+// from both, each run saying what it undoes; --no-undistort takes the frames as they are.
+TEST(Tools, OfflineUndistortsFoldersAndBagsAlike) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --track line --frames 6 --length 10 " +
+                                    "--seed 4 --k1 -0.2 --k2 0.05 --bag " + (dir / "flight.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --config " + (dir / "size128.yaml");
+  std::ofstream(dir / "size128.yaml") << "registration:\n   size: 128\n";
+  const ToolRun folder = run(dir, offline + " --images " + (dir / "flight") + " --output " + (dir / "folder.tum"));
+  ASSERT_EQ(folder.status, 0) << folder.err;
+  EXPECT_NE(folder.err.find("undistorting (cam_param.yaml: k1 -0.2 k2 0.05): 128x128 working frames, fx = fy"), std::string::npos)
+      << folder.err;
+  const ToolRun bag = run(dir, offline + " --bag " + (dir / "flight.bag") + " --output " + (dir / "bag.tum"));
+  ASSERT_EQ(bag.status, 0) << bag.err;
+  EXPECT_NE(bag.err.find("undistorting (CameraInfo on /camera/camera_info: k1 -0.2 k2 0.05)"), std::string::npos)
+      << bag.err;
+  // Equal up to float rounding (FFTW picks its algorithms by timing, per process).
+  EXPECT_LT(largestDifference(poses(dir / "folder.tum"), poses(dir / "bag.tum")), 1e-6);
+  ASSERT_EQ(poses(dir / "folder.tum").size(), 6u);
+  EXPECT_GT(largestDifference({poses(dir / "folder.tum")[1]}, {poses(dir / "folder.tum")[0]}), 0.1);  // it moved
+
+  const ToolRun raw = run(dir, offline + " --no-undistort --images " + (dir / "flight") + " --output " + (dir / "raw.tum"));
+  ASSERT_EQ(raw.status, 0) << raw.err;
+  EXPECT_EQ(raw.err.find("undistorting"), std::string::npos) << raw.err;
+  EXPECT_GT(largestDifference(poses(dir / "raw.tum"), poses(dir / "folder.tum")), 0.1);
+}
+
+// A calibration of another resolution is said in one line; an unusable cam_param.yaml stops the
+// run with one line naming the file and the problem (exit status 1).
+TEST(Tools, OfflineSaysHowTheCalibrationIsUsedAndRefusesUnusableOnes) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const std::string yaml = dir / "flight/cam_param.yaml";
+  const std::string command = std::string(OEFMT_OFFLINE) + " --images " + (dir / "flight") + " --output " + (dir / "x.tum");
+  const std::string quiet = std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") + " --output " + (dir / "x.tum");
+  const auto camParam = [&](const std::string& distortion) {
+    std::ofstream(yaml) << "%YAML:1.0\nCamera.fx: 2955.7\nCamera.fy: 2949.9\nCamera.cx: 2023.1\n"
+                           "Camera.cy: 1510.7\nCamera.width: 4056\nCamera.height: 3040\n"
+                        << distortion;
+  };
+  camParam("");
+  const ToolRun authors = run(dir, command);
+  ASSERT_EQ(authors.status, 0) << authors.err;
+  EXPECT_NE(authors.err.find("oefmt_offline: cam_param.yaml describes a 4056x3040 camera; the 128x128 images are "
+                             "taken as its centred 3040x3040 crop resized: fx 124.5 px"),
+            std::string::npos)
+      << authors.err;
+  const auto expectRefused = [&](const std::string& distortion, const std::string& part) {
+    camParam(distortion);
+    const ToolRun refused = run(dir, quiet);
+    EXPECT_EQ(refused.status, 1) << distortion;
+    EXPECT_NE(refused.err.find(part), std::string::npos) << refused.err;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  };
+  expectRefused("Camera.k1: -5.0\n", "error: cam_param.yaml: lens distortion (k1 -5) cannot be undone");
+  expectRefused("Camera.k1: 1e300\nCamera.k2: 1e300\n", "cannot be undone");
+  expectRefused("Camera.k2: nan\n", "Camera.k2 is not finite");
+  expectRefused("Camera.type: \"KannalaBrandt8\"\n", "Camera.type 'KannalaBrandt8' is not supported");
 }
 
 // Frames smaller than registration.size are upscaled, which registers worse: a warning names the

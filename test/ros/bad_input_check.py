@@ -6,7 +6,9 @@ counts it in /diagnostics), and tracks again when good frames return.
 
 Bad input: an unsupported encoding, black and NaN frames, a duplicate and an out-of-order stamp,
 a change of image size, a corrupt compressed-looking payload in a raw message (wrong step), a
-tiny frame (40 x 30: refused) and a full-resolution 4056 x 3040 camera frame (a restart).
+tiny frame (40 x 30: refused), a full-resolution 4056 x 3040 camera frame (a restart), and
+camera_info with a fisheye model, a non-finite and a folding distortion (frames refused, the
+problem named in /diagnostics) before a usable distorted one.
 """
 import math
 import sys
@@ -60,10 +62,12 @@ class BadInputCheck(unittest.TestCase):
             target.append(message)
 
     @classmethod
-    def publish_info(cls, size):
+    def publish_info(cls, size, model="", D=()):
         info = CameraInfo()
         info.width = info.height = size
         info.K = [0.8 * size, 0, size / 2 - 0.5, 0, 0.8 * size, size / 2 - 0.5, 0, 0, 1]
+        info.distortion_model = model
+        info.D = list(D)
         info.header.frame_id = "camera_optical"
         cls.info.publish(info)
         time.sleep(0.3)
@@ -118,6 +122,20 @@ class BadInputCheck(unittest.TestCase):
         for _ in range(5):                                              # new image size
             cls.good(k, size=200)
             k += 1
+        cls.count_before_bad_info = len(cls.odometry)
+        for model, D in (("equidistant", [0.1, 0.01, 0.0, 0.0]),        # fisheye: not a pinhole
+                         ("plumb_bob", [float("nan"), 0.0, 0.0, 0.0, 0.0]),
+                         ("plumb_bob", [-5.0, 0.0, 0.0, 0.0, 0.0])):    # folds over: no inverse
+            cls.publish_info(200, model, D)
+            for _ in range(2):
+                cls.good(k, size=200)
+                k += 1
+            time.sleep(1.2)  # a diagnostics period names the problem
+        cls.count_after_bad_info = len(cls.odometry)
+        cls.publish_info(200, "plumb_bob", [-0.1, 0.01, 0.0, 0.0, 0.0])  # a real lens again
+        for _ in range(4):
+            cls.good(k, size=200)
+            k += 1
         time.sleep(2.5)  # a diagnostics period
 
     def test_node_keeps_publishing_after_bad_input(self):
@@ -136,6 +154,20 @@ class BadInputCheck(unittest.TestCase):
             for i in range(6):
                 self.assertTrue(math.isfinite(m.pose.covariance[i * 7]))
                 self.assertGreater(m.pose.covariance[i * 7], 0.0)
+
+    def test_unusable_camera_info_is_named_and_survived(self):
+        with self.lock:
+            statuses = [s for a in self.diagnostics for s in a.status if "odometry" in s.name]
+            count = len(self.odometry)
+        problems = [kv.value for s in statuses for kv in s.values if kv.key == "last problem"]
+        for part in ("distortion model 'equidistant' is not supported",
+                     "distortion coefficients (D) are not finite",
+                     "lens distortion (k1 -5) cannot be undone"):
+            self.assertTrue(any(part in p for p in problems), f"no '{part}' in {sorted(set(problems))}")
+        self.assertTrue(all("\n" not in p for p in problems))
+        self.assertEqual(self.count_after_bad_info, self.count_before_bad_info,
+                         "frames of an unusable camera_info were registered")
+        self.assertGreaterEqual(count, self.count_after_bad_info + 3, "odometry did not resume")
 
     def test_rejections_are_counted(self):
         with self.lock:

@@ -8,7 +8,10 @@ truth, and that the node's trajectory equals oefmt_offline's on the same bag.
 
 Private parameters: ~compressed (bool), ~rate (playback speed factor), ~frames, ~max_ate_mean [m]
 (mean absolute trajectory error after a 2-D similarity alignment), ~compare_offline (bool),
-~size (image size of the rendered flight).
+~size (image size of the rendered flight), ~seed (scene), ~simulate_args (more oefmt_simulate
+options, e.g. a lens distortion that goes into the bag's CameraInfo), ~camera_info_scale (the
+bag's CameraInfo rewritten for a camera of that many times the images' resolution, which the
+node and oefmt_offline map back to the images).
 """
 import json
 import math
@@ -74,6 +77,9 @@ class ReplayCheck(unittest.TestCase):
         # frames upscaled to the 512 working size leave frames 3-6 of this piece unregistered in
         # every mode.
         cls.size = int(rospy.get_param("~size", 512))
+        cls.seed = int(rospy.get_param("~seed", 3))
+        cls.simulate_args = str(rospy.get_param("~simulate_args", "")).split()
+        cls.camera_info_scale = float(rospy.get_param("~camera_info_scale", 1.0))
         # With ~mount_yaw, the camera body is mounted turned by that yaw in base_link (static
         # TF base_link -> camera_optical): the node's odometry is the offline one turned by it.
         cls.mount_yaw = float(rospy.get_param("~mount_yaw", 0.0))
@@ -86,11 +92,14 @@ class ReplayCheck(unittest.TestCase):
         # A short piece of the default circle (same speed and altitude), multi-depth scene.
         length = 491.0 * cls.frames / 200.0
         run([tool("oefmt_simulate"), "--quiet", "--track", "circle", "--length", str(length),
-             "--frames", str(cls.frames), "--size", str(cls.size), "--seed", "3", cls.flight])
+             "--frames", str(cls.frames), "--size", str(cls.size), "--seed", str(cls.seed)]
+            + cls.simulate_args + [cls.flight])
         if cls.compressed:
             run([tool("oefmt_folder_to_bag"), "--quiet", "--format", "png", cls.flight, cls.bag])
         else:
             run([tool("oefmt_folder_to_bag"), "--quiet", cls.flight, cls.bag])
+        if cls.camera_info_scale != 1.0:
+            cls.rescale_camera_info(cls.bag, cls.camera_info_scale)
 
         cls.odometry, cls.energy, cls.diagnostics, cls.paths = [], [], [], []
         cls.debug_images = {"rotation_zoom": [], "translation": []}
@@ -133,6 +142,26 @@ class ReplayCheck(unittest.TestCase):
         run(["rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", "-r", str(cls.rate),
              cls.bag])
         time.sleep(2.0)  # let the last frames through
+
+    @staticmethod
+    def rescale_camera_info(path, scale):
+        """Rewrites the bag's CameraInfo as a camera of `scale` times the images' size (pixel
+        centres at integer coordinates: c -> (c + 0.5) * scale - 0.5)."""
+        import rosbag
+        original = path + ".original"
+        os.rename(path, original)
+        with rosbag.Bag(original) as source, rosbag.Bag(path, "w") as target:
+            for topic, message, t in source.read_messages():
+                if message._type == "sensor_msgs/CameraInfo":
+                    message.width = int(round(message.width * scale))
+                    message.height = int(round(message.height * scale))
+                    k = list(message.K)
+                    k[0], k[4] = k[0] * scale, k[4] * scale
+                    k[2], k[5] = (k[2] + 0.5) * scale - 0.5, (k[5] + 0.5) * scale - 0.5
+                    message.K = k
+                    message.P = [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0]
+                target.write(topic, message, t)
+        os.remove(original)
 
     @classmethod
     def tearDownClass(cls):

@@ -5,6 +5,7 @@
 
 #include <fstream>
 #include <functional>
+#include <iterator>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -164,6 +165,35 @@ TEST(Dataset, CameraParametersRoundTrip) {
   EXPECT_EQ(read.intrinsics.height, 500);
   EXPECT_EQ(read.distortion.k2, 0.02);
   EXPECT_EQ(read.distortion.p2, -0.002);
+}
+
+// k3 (ORB-SLAM-style files) and the rational k4..k6 are read and written; the authors' ten keys
+// stay the only ones when those are zero; Camera.type other than PinHole is refused by name.
+TEST(Dataset, CameraParametersHigherOrderDistortionAndType) {
+  TempDir dir;
+  CameraParameters camera;
+  camera.intrinsics = {400.25, 401.5, 255.5, 250.125, 512, 500};
+  camera.distortion.k1 = -0.3;
+  writeCameraParameters(dir / "plain.yaml", camera);
+  std::ifstream plain(dir / "plain.yaml");
+  const std::string plain_text((std::istreambuf_iterator<char>(plain)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(plain_text.find("Camera.k3"), std::string::npos);
+  EXPECT_NE(plain_text.find("Camera.p2"), std::string::npos);
+  camera.distortion.k3 = 0.01;
+  camera.distortion.k4 = 0.2;
+  camera.distortion.k6 = -0.05;
+  writeCameraParameters(dir / "cam.yaml", camera);
+  const CameraParameters read = readCameraParameters(dir / "cam.yaml");
+  EXPECT_EQ(read.distortion.k3, 0.01);
+  EXPECT_EQ(read.distortion.k4, 0.2);
+  EXPECT_EQ(read.distortion.k5, 0.0);
+  EXPECT_EQ(read.distortion.k6, -0.05);
+  EXPECT_TRUE(read.distortion.rational());
+  EXPECT_EQ(read.distortion.text(), "k1 -0.3 k3 0.01 k4 0.2 k6 -0.05");
+  writeText(dir / "fisheye.yaml", "Camera.type: \"KannalaBrandt8\"\nCamera.fx: 1\nCamera.fy: 1\nCamera.cx: 1\nCamera.cy: 1\n");
+  expectDatasetError([&] { readCameraParameters(dir / "fisheye.yaml"); }, "Camera.type 'KannalaBrandt8' is not supported");
+  writeText(dir / "pinhole.yaml", "Camera.type: pinhole\nCamera.fx: 1\nCamera.fy: 1\nCamera.cx: 1\nCamera.cy: 1\n");
+  EXPECT_FALSE(readCameraParameters(dir / "pinhole.yaml").distortion.any());
 }
 
 TEST(Dataset, IntrinsicsForImageSize) {

@@ -42,10 +42,14 @@ cv::Mat imageFromMessage(const sensor_msgs::CompressedImage& message);
 /// 16UC3 bgr16, 32FC1, 64FC1). Throws BagError for another type.
 sensor_msgs::Image imageMessage(const cv::Mat& image, double stamp, const std::string& frame_id);
 
-/// CameraInfo of `camera`: plumb_bob with D = (k1, k2, p1, p2, 0), K, R = I, P = [K | 0].
+/// CameraInfo of `camera`: plumb_bob with D = (k1, k2, p1, p2, k3) (rational_polynomial with
+/// the eight coefficients when k4..k6 are not zero), K, R = I, P = [K | 0].
 sensor_msgs::CameraInfo cameraInfoMessage(const CameraParameters& camera, double stamp,
                                           const std::string& frame_id);
-/// Intrinsics and (plumb_bob) distortion of a CameraInfo. Throws BagError when K is zero.
+/// Intrinsics and distortion of a CameraInfo: plumb_bob (D = k1 k2 p1 p2 [k3]) or
+/// rational_polynomial (D = k1 k2 p1 p2 k3 k4 k5 k6); an empty model only without distortion.
+/// Throws BagError, naming the model, for another model (e.g. equidistant), for more coefficients
+/// than the model has, for a zero K and for non-finite values.
 CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info);
 
 /// One image read from a bag.

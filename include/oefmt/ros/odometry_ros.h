@@ -32,6 +32,7 @@
 #include "oefmt/estimator_config.h"
 #include "oefmt/ros/frame_queue.h"
 #include "oefmt/stamp_guard.h"
+#include "oefmt/undistortion.h"
 
 namespace oefmt {
 
@@ -49,6 +50,9 @@ struct RosParameters {
   /// Focal length [px] of the camera images, used when no camera_info arrives. (Not the YAML's
   /// `fx`, which is the working image's and is set from this or from camera_info.)
   double camera_fx = 0.0;
+  /// Undo the lens distortion camera_info gives (false: the images are already rectified, or
+  /// camera_info's D belongs to another lens than the one that took them).
+  bool undistort = true;
   double initial_altitude = 0.0;     ///< altitude above the dominant plane at start [m], 0 = unknown
   bool use_altitude_topic = false;   ///< take the initial altitude from the `altitude` Range topic
   double time_jump_tolerance = 1.0;  ///< a stamp this far back [s] resets (bag loop)
@@ -89,7 +93,9 @@ class OdometryRos {
   void process(const InputFrame& frame);
   bool prepareEstimator(const InputFrame& frame, const cv::Mat& image);
   cv::Mat decode(const InputFrame& frame);
-  void undistortIfNeeded(cv::Mat& image);
+  /// Sets up undistorter_ for this calibration and image size unless it already is; throws
+  /// InputError (naming `source`) when the calibration cannot be used.
+  void updateUndistorter(const CameraParameters& calibration, const std::string& source, cv::Size image_size);
   void lookUpCameraMount(const InputFrame& frame);
   void publish(const InputFrame& frame, const Estimate& estimate);
   void publishDebugImages(const InputFrame& frame, const Estimate& estimate);
@@ -128,8 +134,17 @@ class OdometryRos {
   double mount_yaw_ = 0.0;  ///< yaw of the camera body (x = image right) in base_frame, from TF
   cv::Size input_size_;
   double estimator_fx_ = 0.0;
-  cv::Mat undistort_map1_, undistort_map2_;
-  std::string undistort_key_;
+  std::unique_ptr<const Undistorter> undistorter_;  ///< of the current calibration and image size
+  /// The last calibration that could not be set up, so that it is reported, not retried, per frame.
+  struct FailedCamera {
+    CameraParameters calibration;
+    cv::Size image_size;
+    std::string error;
+    bool madeFor(const CameraParameters& c, cv::Size size) const {
+      return size == image_size && sameCamera(c, calibration);
+    }
+  };
+  std::optional<FailedCamera> failed_camera_;
   std::atomic<bool> reset_requested_{false};
 
   // Counters for diagnostics (atomics: written by callbacks and worker, read by the updater).

@@ -24,7 +24,8 @@ struct FlightPose {
 /// Rotation of the camera's optical frame into the world: Rz(yaw) * Rx(pi).
 cv::Matx33d opticalToWorld(double yaw);
 
-/// Applies the radial-tangential model to normalised coordinates (undistorted -> distorted).
+/// Applies the radial-tangential (and rational) model to normalised coordinates (undistorted ->
+/// distorted), as OpenCV does.
 cv::Point2d distortNormalised(const Distortion& distortion, cv::Point2d undistorted);
 
 /// Inverts distortNormalised by fixed-point iteration (accurate to ~1e-12 for usual lenses).
