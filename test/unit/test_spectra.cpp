@@ -255,7 +255,8 @@ TEST(Spectra, NoisePowerOfWhiteNoiseIsItsMeanPowerPerFrequency) {
     cv::RNG(11).fill(noise, cv::RNG::NORMAL, 0.0, sigma);
     cv::Mat2f spectrum;
     fft.forward(noise, spectrum);
-    EXPECT_NEAR(noisePower(spectrum) / (n * n * sigma * sigma), 1.0, 0.05) << sigma;
+    // A quartile of a few thousand exponential values: within about 5 % (one sigma).
+    EXPECT_NEAR(noisePower(spectrum) / (n * n * sigma * sigma), 1.0, 0.15) << sigma;
   }
   // A smooth image has (almost) no power out there.
   cv::Mat1f smooth(n, n);
