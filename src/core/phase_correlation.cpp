@@ -250,36 +250,48 @@ SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int hal
   const bool weighted = sigma.x > 0.0 && sigma.y > 0.0;
   cv::Point best(wrap(centre.x, surface.cols), wrap(centre.y, surface.rows));
   double best_score = -std::numeric_limits<double>::infinity();
+  // The window's columns as at most two runs of the row (a cyclic window may wrap around).
+  int runs[2][2];
+  int run_count = 0;
+  const int first_col = centre.x - half_cols, last_col = centre.x + half_cols;
+  if (cyclic_cols) {
+    const int a = wrap(first_col, surface.cols);
+    const int length = std::min(last_col - first_col + 1, surface.cols);
+    runs[run_count][0] = a;
+    runs[run_count++][1] = std::min(a + length, surface.cols);
+    if (a + length > surface.cols) {
+      runs[run_count][0] = 0;
+      runs[run_count++][1] = a + length - surface.cols;
+    }
+  } else {
+    runs[run_count][0] = std::max(first_col, 0);
+    runs[run_count++][1] = std::min(last_col + 1, surface.cols);
+  }
   for (int dr = -half_rows; dr <= half_rows; ++dr) {
-    const float* row = surface[wrap(centre.y + dr, surface.rows)];
-    for (int dc = -half_cols; dc <= half_cols; ++dc) {
-      int c = centre.x + dc;
-      if (cyclic_cols) {
-        c = wrap(c, surface.cols);
-      } else if (c < 0 || c >= surface.cols) {
-        continue;
-      }
-      const int r = wrap(centre.y + dr, surface.rows);
-      // Within a cell of the excluded peak (rows wrap, and columns when cyclic).
-      const int er = std::abs(r - exclude.y), ec = std::abs(c - exclude.x);
-      if (std::min(er, surface.rows - er) <= 1 &&
-          (cyclic_cols ? std::min(ec, surface.cols - ec) : ec) <= 1) {
-        continue;
-      }
-      double score = row[c];
-      // The weight is at most 1: a value no higher than the best score cannot win.
-      if (!(score > best_score) || !(row[c] >= min_value)) continue;
-      if (weighted) {
-        // Only peaks compete: a weighted value on a peak's flank nearer the prediction must not
-        // stand in for the peak.
-        if (!(score > 0.0) || !isLocalMaximum(surface, r, c, cyclic_cols)) {
-          continue;
+    const int r = wrap(centre.y + dr, surface.rows);
+    const float* row = surface[r];
+    const bool excluded_row = std::min(std::abs(r - exclude.y), surface.rows - std::abs(r - exclude.y)) <= 1;
+    for (int run = 0; run < run_count; ++run) {
+      for (int c = runs[run][0]; c < runs[run][1]; ++c) {
+        // The weight is at most 1: a value no higher than the best score cannot win.
+        const float v = row[c];
+        if (!(v >= min_value) || !(v > best_score)) continue;
+        if (excluded_row) {  // within a cell of the excluded peak (rows and columns wrap)
+          const int ec = std::abs(c - exclude.x);
+          if ((cyclic_cols ? std::min(ec, surface.cols - ec) : ec) <= 1) continue;
         }
-        score *= std::exp(-0.5 * (dc * dc / (sigma.x * sigma.x) + dr * dr / (sigma.y * sigma.y)));
-      }
-      if (score > best_score) {
-        best_score = score;
-        best = cv::Point(c, r);
+        double score = v;
+        if (weighted) {
+          // Only peaks compete: a weighted value on a peak's flank nearer the prediction must
+          // not stand in for the peak.
+          if (!(score > 0.0) || !isLocalMaximum(surface, r, c, cyclic_cols)) continue;
+          const double dc = cyclic_cols ? std::remainder(c - centre.x, double(surface.cols)) : c - centre.x;
+          score *= std::exp(-0.5 * (dc * dc / (sigma.x * sigma.x) + dr * dr / (sigma.y * sigma.y)));
+        }
+        if (score > best_score) {
+          best_score = score;
+          best = cv::Point(c, r);
+        }
       }
     }
   }

@@ -365,7 +365,13 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   }
   const cv::Mat2f& older_spectrum = result.warped ? warped_spectrum_ : older.spectrum;
 
-  if (test_half_turn && context_->config().resolve_half_turn) {
+  if (test_half_turn && context_->config().resolve_half_turn && prior != nullptr) {
+    // The surface reads the rotation modulo a half turn: the prediction says which.
+    if (std::fabs(wrapAngle(result.rotation - prior->rotation)) > CV_PI / 2.0) {
+      result.half_turn = true;
+      result.rotation = wrapAngle(result.rotation + CV_PI);
+    }
+  } else if (test_half_turn && context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
     // hypothesis needs no second warp; a low-resolution correlation decides between the two
     // and only the winner gets the full-size inverse FFT.
@@ -378,10 +384,9 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
   }
-  // The warp resamples the older frame (and its noise): its own noise power.
-  const float older_noise = !context_->config().noise_weighting ? 0.0f
-                            : result.warped                       ? noisePower(warped_spectrum_)
-                                                                  : older.noise_power;
+  // The older frame's noise power also stands for its warp (whose bilinear resampling lowers the
+  // noise at high frequencies a little: those are weighted down a little more).
+  const float older_noise = context_->config().noise_weighting ? older.noise_power : 0.0f;
   centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn,
                     SimdKernel::kAuto, newer.noise_power, older_noise);
   fft.inverseInPlace(cross_power_);
