@@ -43,6 +43,8 @@ struct Estimate {
   /// or the optimizer fell back to raw measurements, or the pair was only just usable).
   bool degraded = false;
   int frame_gap = 0;  ///< frame intervals between frame 1 and this frame (1 unless frames failed)
+  /// What the motion so far predicted for pair 1-2 (none at the start or after a restart).
+  std::optional<RegistrationPrior> prediction12;
   /// The measured step departed from the motion so far by more than the vehicle's acceleration
   /// allows: the predicted step was integrated instead (with a covariance covering both).
   bool step_implausible = false;

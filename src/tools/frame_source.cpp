@@ -17,7 +17,9 @@ class FolderSource : public FrameSource {
   bool next(SourceFrame& frame) override {
     if (index_ >= dataset_.size()) return false;
     frame.index = index_;
-    frame.stamp = static_cast<double>(index_);  // the authors' ground truth is indexed by frame
+    // timestamps.txt's seconds (the motion model needs the frame interval), else the frame index
+    // (as the authors' ground truth is indexed).
+    frame.stamp = dataset_.timestamp(index_);
     frame.name = dataset_.imageName(index_);
     frame.image = dataset_.loadImage(index_);
     ++index_;

@@ -23,7 +23,7 @@ namespace oefmt {
 
 struct SourceFrame {
   std::size_t index = 0;
-  double stamp = 0.0;    ///< TUM time: frame index for folders, header stamp [s] for bags
+  double stamp = 0.0;    ///< [s]: timestamps.txt (else the frame index) for folders, header stamp for bags
   cv::Mat image;         ///< as decoded; released once `spectra` is made
   cv::Size image_size;   ///< of the decoded image (kept when the image is released)
   FrameSpectra spectra;  ///< made by PrefetchingSource's `analyse`, when it has one
