@@ -34,9 +34,6 @@ constexpr int kEnergyRowBand = 12;
 // the log-polar peak, narrower than a quarter turn's distance.
 constexpr int kTriedPeakRadius = 6;
 
-// Rotation/zoom peaks tried within a prediction's window: once the best is cleared, the next
-// lies at the window's edge.
-constexpr int kWindowCandidates = 2;
 // A second peak of the window whose weighted height reaches this share of the first's competes
 // with it (both are registered).
 constexpr double kCompetingPeak = 0.5;
