@@ -1,12 +1,19 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Prints config/default.yaml as a Markdown table (key | type | default | unit | meaning), for
-the README: the YAML file's comments are the one source of every parameter's documentation."""
+the README: the YAML file's comments are the one source of every parameter's documentation.
+
+  params_table.py [config/default.yaml]                      print the table
+  params_table.py config/default.yaml --check README.md [--junit FILE]
+                                                             fail when README.md lacks it
+"""
+import argparse
 import re
 import sys
+from xml.sax.saxutils import escape
 
 
-def main(path):
+def table(path):
     rows, comment, section = [], [], ""
     with open(path) as f:
         for raw in f:
@@ -37,11 +44,39 @@ def main(path):
                                    described.group(3)) if described else ("", "", doc)
             rows.append((full, kind, value, unit, meaning.replace("|", "\\|")))
             comment = []
-    print("| key | type | default | unit | meaning |")
-    print("|---|---|---|---|---|")
-    for row in rows:
-        print("| `{}` | {} | `{}` | {} | {} |".format(*row))
+    lines = ["| key | type | default | unit | meaning |", "|---|---|---|---|---|"]
+    lines += ["| `{}` | {} | `{}` | {} | {} |".format(*row) for row in rows]
+    return "\n".join(lines) + "\n"
+
+
+def write_junit(path, failure):
+    body = f'<failure message="{escape(failure, {chr(34): "&quot;"})}"/>' if failure else ""
+    with open(path, "w") as f:
+        f.write('<?xml version="1.0" encoding="UTF-8"?>\n'
+                f'<testsuite name="parameter_table" tests="1" failures="{int(bool(failure))}">'
+                f'<testcase classname="parameter_table" name="readme_matches_default_yaml">{body}'
+                '</testcase></testsuite>\n')
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("config", nargs="?", default="config/default.yaml")
+    parser.add_argument("--check", metavar="README", help="check that this file holds the table")
+    parser.add_argument("--junit", metavar="FILE", help="with --check: the result as JUnit XML")
+    args = parser.parse_args()
+    generated = table(args.config)
+    if not args.check:
+        sys.stdout.write(generated)
+        return 0
+    with open(args.check) as f:
+        failure = "" if generated in f.read() else (
+            f"{args.check} does not hold the parameter table of {args.config}: "
+            f"regenerate it with scripts/params_table.py {args.config}")
+    if args.junit:
+        write_junit(args.junit, failure)
+    print(failure or f"{args.check}: parameter table up to date")
+    return 1 if failure else 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "config/default.yaml")
+    sys.exit(main())
