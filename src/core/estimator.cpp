@@ -53,6 +53,12 @@ constexpr double kTranslationWindowFloor = 2.0;
 // overlap moves 0.7 N).
 constexpr double kMaxPairShiftFraction = 0.45;
 
+// The middle value (the upper middle of an even count).
+double medianOf(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
 // Whether a pair's rotation and zoom lie within the prediction's window (true without one).
 bool withinWindow(const PairMotion& motion, const std::optional<RegistrationPrior>& prior) {
   return !prior || (std::fabs(wrapToPi(motion.rotation - prior->rotation)) <= prior->rotation_window &&
@@ -207,41 +213,43 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
   // and zoom would only repeat the prediction), the translations from all the last steps.
   const std::deque<PairMotion>& rates = recent_rates.empty() ? recent_steps : recent_rates;
   // The median of the last steps' values: one wrong step does not move the prediction.
-  const auto medianOf = [](const std::deque<PairMotion>& steps, auto field) {
+  const auto medianOfSteps = [](const std::deque<PairMotion>& steps, auto field) {
     std::vector<double> values;
     for (const PairMotion& m : steps) values.push_back(field(m));
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    return values[values.size() / 2];
+    return medianOf(std::move(values));
   };
-  const auto rate = [&](auto field) { return medianOf(rates, field); };
-  const auto median = [&](auto field) { return medianOf(recent_steps, field); };
+  const auto rate = [&](auto field) { return medianOfSteps(rates, field); };
+  const auto median = [&](auto field) { return medianOfSteps(recent_steps, field); };
   RegistrationPrior prior;
   prior.rotation = rate([](const PairMotion& m) { return m.rotation; }) * intervals;
   prior.log_zoom = rate([](const PairMotion& m) { return m.log_zoom; }) * intervals;
   double rotation_sigma = rate([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
   double log_zoom_sigma = rate([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
   const double rotation12 = prior.rotation, log_zoom12 = prior.log_zoom;
-  // How far the last steps strayed from the median, plus a frame interval's change of the rates
-  // (a third of the window, as for a registration on the prediction).
+  // The window's fixed part in rotation and ln zoom, and a third of it: a frame interval's
+  // possible change of the rates.
+  const double rotation_bins = kPriorWindowBins * CV_PI / n;
+  const double log_zoom_bins = kPriorWindowBins * registrar.logZoomPerBin();
+  // How far the last steps strayed from the median, plus a frame interval's change of the rates.
   double rotation_spread = 0.0, log_zoom_spread = 0.0;
   for (const PairMotion& m : rates) {
     rotation_spread = std::max(rotation_spread, std::fabs(m.rotation * intervals - rotation12));
     log_zoom_spread = std::max(log_zoom_spread, std::fabs(m.log_zoom * intervals - log_zoom12));
   }
-  prior.rotation_spread = std::hypot(rotation_spread, kPriorWindowBins * CV_PI / n / 3.0);
-  prior.log_zoom_spread = std::hypot(log_zoom_spread, kPriorWindowBins * registrar.logZoomPerBin() / 3.0);
+  prior.rotation_spread = std::hypot(rotation_spread, rotation_bins / 3.0);
+  prior.log_zoom_spread = std::hypot(log_zoom_spread, log_zoom_bins / 3.0);
   if (start != nullptr) {
     prior.rotation += start->rotation;
     prior.log_zoom += start->log_zoom;
     rotation_sigma = std::hypot(rotation_sigma, start->rotation_sigma);
     log_zoom_sigma = std::hypot(log_zoom_sigma, start->log_zoom_sigma);
   }
-  prior.rotation_window = kPriorWindowBins * CV_PI / n + 3.0 * rotation_sigma;
-  prior.log_zoom_window = kPriorWindowBins * registrar.logZoomPerBin() + 3.0 * log_zoom_sigma;
+  prior.rotation_window = rotation_bins + 3.0 * rotation_sigma;
+  prior.log_zoom_window = log_zoom_bins + 3.0 * log_zoom_sigma;
   // A registration on the prediction itself measured neither: the prediction's own sigma plus a
-  // frame interval's change of the rates (a third of the window).
-  prior.rotation_sigma = std::hypot(rotation_sigma, kPriorWindowBins * CV_PI / n / 3.0);
-  prior.log_zoom_sigma = std::hypot(log_zoom_sigma, kPriorWindowBins * registrar.logZoomPerBin() / 3.0);
+  // frame interval's change of the rates.
+  prior.rotation_sigma = std::hypot(rotation_sigma, rotation_bins / 3.0);
+  prior.log_zoom_sigma = std::hypot(log_zoom_sigma, log_zoom_bins / 3.0);
   if (last_step && seconds > 0.0) {
     // The translation per interval in the camera's axes: the median length of the last steps,
     // and the last direction turned on by the median turn between steps (steady in a
@@ -254,11 +262,9 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
       for (std::size_t k = 1; k < recent_steps.size(); ++k) {
         turns.push_back(wrapToPi(recent_steps[k].direction() - recent_steps[k - 1].direction()));
       }
-      const std::vector<double> all_turns = turns;
-      std::nth_element(turns.begin(), turns.begin() + turns.size() / 2, turns.end());
-      const double turn = turns[turns.size() / 2];
+      const double turn = medianOf(turns);
       direction += turn;
-      for (const double t : all_turns) turn_spread = std::max(turn_spread, std::fabs(t - turn));
+      for (const double t : turns) turn_spread = std::max(turn_spread, std::fabs(t - turn));
     }
     const cv::Point2d per_interval = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
     // How far the last steps strayed from it: along (their lengths) and across (their turns).
@@ -331,8 +337,8 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
     est.state = TrackingState::kPredicted;
     // The next frame would be registered against frame 1 over one more interval: at low overlap
     // that pair is out of reach, and every later frame would fail too.
-    const int next_intervals = static_cast<int>(frame.index - f1->index) + 1;
-    if (textured && f1 && !shiftInReach(last_step->translation * next_intervals)) {
+    if (textured && f1 &&
+        !shiftInReach(last_step->translation * (static_cast<double>(frame.index - f1->index) + 1.0))) {
       slideTo(std::move(frame), predicted);
       return;
     }
@@ -427,7 +433,6 @@ PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
 PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, bool with02) {
   Clock::time_point t = Clock::now();
   if (with02) {
-    if (!pending02.valid()) prior02 = predictedPair(est.frame_gap, frame.stamp - f1->stamp, &motion01);
     est.registration02 = pending02.valid()
                              ? pending02.get()
                              : registrar02.registerPair(f0->spectra, frame.spectra,
@@ -635,17 +640,16 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                                           ? RegistrationMethod::kClassic
                                           : RegistrationMethod::kEnergyVectors;
     const Clock::time_point t = Clock::now();
+    const double seconds12 = frame.stamp - s.f1->stamp;
     const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
-                        s.shiftInReach(s.motion01.translation *
-                                       (double(s.gap01 + frame.index - s.f1->index) / s.gap01));
+                        s.shiftInReach(s.motion01.translation * (double(s.gap01 + est.frame_gap) / s.gap01));
+    s.prior02 = with02 ? s.predictedPair(est.frame_gap, seconds12, &s.motion01) : std::nullopt;
     if (with02 && config_.parallel_registrations) {
       // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
       // cached spectra; each Registrar has its own scratch). Collected in oefmtStep; discarded
       // if pair 1-2 fails.
       const FrameSpectra& older = s.f0->spectra;
       const FrameSpectra& newer = frame.spectra;
-      s.prior02 = s.predictedPair(static_cast<int>(frame.index - s.f1->index), frame.stamp - s.f1->stamp,
-                                  &s.motion01);
       s.pending02 = s.worker02.submit([&s, &older, &newer] {
         return s.registrar02.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr,
                                           s.prior02 ? &*s.prior02 : nullptr);
@@ -654,7 +658,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     const PendingPairGuard pending_guard(s.pending02);
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
-    s.prior12 = s.predictedPair(est.frame_gap, frame.stamp - s.f1->stamp, nullptr);
+    s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
     est.prediction12 = s.prior12;
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
                                                   s.prior12 ? &*s.prior12 : nullptr);
