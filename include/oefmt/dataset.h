@@ -65,6 +65,9 @@ void writeCameraParameters(const std::string& path, const CameraParameters& came
 /// the authors' 4056x3040 camera and 512x512 images: a centred 3040x3040 crop scaled by 512/3040).
 /// Pixel centres sit at integer coordinates. Throws InputError for invalid intrinsics or size.
 Intrinsics intrinsicsForImageSize(const Intrinsics& camera, cv::Size image_size);
+/// That crop: the largest centred region of the camera image with the images' aspect ratio
+/// [camera px]. Expects valid intrinsics and a positive size (see intrinsicsForImageSize).
+cv::Size2d centredCropForImageSize(const Intrinsics& camera, cv::Size image_size);
 
 /// Parses one line of timestamps.txt to seconds: a decimal number of seconds, or the authors'
 /// 14-digit calendar stamp YYYYMMDDhhmmss (UTC). Returns false for anything else.

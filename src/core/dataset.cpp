@@ -166,17 +166,22 @@ void writeCameraParameters(const std::string& path, const CameraParameters& came
   if (!out) throw DatasetError("cannot write camera parameters '" + path + "'");
 }
 
+cv::Size2d centredCropForImageSize(const Intrinsics& camera, cv::Size image_size) {
+  const double aspect = static_cast<double>(image_size.width) / image_size.height;
+  cv::Size2d crop(camera.width, camera.height);
+  if (crop.width / crop.height > aspect) {
+    crop.width = crop.height * aspect;
+  } else {
+    crop.height = crop.width / aspect;
+  }
+  return crop;
+}
+
 Intrinsics intrinsicsForImageSize(const Intrinsics& camera, cv::Size image_size) {
   if (!camera.valid()) throw InputError("camera intrinsics are invalid (fx, fy, width, height must be > 0)");
   if (image_size.width <= 0 || image_size.height <= 0) throw InputError("image size must be > 0");
-  // Largest centred region of the camera image with the image's aspect ratio.
-  const double aspect = static_cast<double>(image_size.width) / image_size.height;
-  double crop_w = camera.width, crop_h = camera.height;
-  if (crop_w / crop_h > aspect) {
-    crop_w = crop_h * aspect;
-  } else {
-    crop_h = crop_w / aspect;
-  }
+  const cv::Size2d crop = centredCropForImageSize(camera, image_size);
+  const double crop_w = crop.width, crop_h = crop.height;
   const double x0 = (camera.width - crop_w) / 2.0;
   const double y0 = (camera.height - crop_h) / 2.0;
   const double kx = image_size.width / crop_w;

@@ -11,8 +11,6 @@
 namespace oefmt {
 namespace {
 
-constexpr float kTinyMagnitudeSquared = 1e-30f;
-
 void requireSameShape(const cv::Mat2f& a, const cv::Mat2f& b) {
   if (a.size() != b.size() || !a.isContinuous() || !b.isContinuous()) {
     throw InputError("phase correlation: spectra of different shapes");
@@ -37,32 +35,17 @@ void crossPowerRun(const float* p, const float* q, float* out, int count, float 
     }
     return;
   }
+  const float odd_factor = alternate ? -factor : factor;
   if (weighted) {
-    const float odd_factor = alternate ? -factor : factor;
     for (int i = 0; i < count; ++i) {
-      const float pr = p[2 * i], pi = p[2 * i + 1];
-      const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
-      const float re = pr * qr + pi * qi;
-      const float im = pi * qr - pr * qi;
-      const float scale = ((i & 1) ? odd_factor : factor) / std::sqrt(re * re + im * im + kTinyMagnitudeSquared);
-      const float wp = std::max(0.0f, 1.0f - p_noise / (pr * pr + pi * pi + kTinyMagnitudeSquared));
-      const float wq = std::max(0.0f, 1.0f - q_noise / (qr * qr + qi * qi + kTinyMagnitudeSquared));
-      out[2 * i] = re * (scale * (wp * wq));
-      out[2 * i + 1] = im * (scale * (wp * wq));
+      detail::weightedCrossPowerElement(p, q, out, i, conjugate_sign, (i & 1) ? odd_factor : factor,
+                                        p_noise, q_noise);
     }
     return;
   }
-  const float odd_factor = alternate ? -factor : factor;
 #pragma omp simd
   for (int i = 0; i < count; ++i) {
-    const float pr = p[2 * i], pi = p[2 * i + 1];
-    const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
-    const float re = pr * qr + pi * qi;
-    const float im = pi * qr - pr * qi;
-    // + tiny keeps 0/0 out without a branch: a vanished product stays 0.
-    const float inv = ((i & 1) ? odd_factor : factor) / std::sqrt(re * re + im * im + kTinyMagnitudeSquared);
-    out[2 * i] = re * inv;
-    out[2 * i + 1] = im * inv;
+    detail::crossPowerElement(p, q, out, i, conjugate_sign, (i & 1) ? odd_factor : factor);
   }
 }
 

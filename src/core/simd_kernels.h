@@ -40,6 +40,39 @@ static inline void sampleLine(const LineSamples& line, bool avx2) {
   }
 }
 
+/// Keeps 0/0 out of the cross power without a branch: a vanished product stays 0.
+constexpr float kTinyMagnitudeSquared = 1e-30f;
+
+/// Element i of the cross power below, `factor` already the one of its parity: the portable
+/// loop's body and the AVX2 kernels' tails, so that all compute the same. (`static`: see
+/// sampleLine.)
+static inline void crossPowerElement(const float* p, const float* q, float* out, int i,
+                                     float conjugate_sign, float factor) {
+  const float pr = p[2 * i], pi = p[2 * i + 1];
+  const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
+  const float re = pr * qr + pi * qi;
+  const float im = pi * qr - pr * qi;
+  const float scale = factor / __builtin_sqrtf(re * re + im * im + kTinyMagnitudeSquared);
+  out[2 * i] = re * scale;
+  out[2 * i + 1] = im * scale;
+}
+
+/// The same, weighted by the element's share of signal in both spectra (see
+/// crossPowerRowWeightedAvx2).
+static inline void weightedCrossPowerElement(const float* p, const float* q, float* out, int i,
+                                             float conjugate_sign, float factor, float p_noise,
+                                             float q_noise) {
+  const float pr = p[2 * i], pi = p[2 * i + 1];
+  const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
+  const float re = pr * qr + pi * qi;
+  const float im = pi * qr - pr * qi;
+  const float scale = factor / __builtin_sqrtf(re * re + im * im + kTinyMagnitudeSquared);
+  const float wp = __builtin_fmaxf(0.0f, 1.0f - p_noise / (pr * pr + pi * pi + kTinyMagnitudeSquared));
+  const float wq = __builtin_fmaxf(0.0f, 1.0f - q_noise / (qr * qr + qi * qi + kTinyMagnitudeSquared));
+  out[2 * i] = re * (scale * (wp * wq));
+  out[2 * i + 1] = im * (scale * (wp * wq));
+}
+
 /// `count` interleaved complex values: out = p * conj(q) / |p * conj(q)| (q not conjugated
 /// when conjugate_sign is -1), element i times factor, and times (-1)^i when `alternate`.
 void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,

@@ -10,13 +10,6 @@
 
 namespace oefmt {
 namespace detail {
-namespace {
-
-// Keeps 0/0 out of the cross power without a branch (as the portable loop).
-constexpr float kTinyMagnitudeSquared = 1e-30f;
-
-}  // namespace
-
 // p * conj(q) (p * q when sign's odd lanes are -1) of four interleaved complex values.
 static inline __m256 complexProducts(const float* p, const float* q, __m256 sign) {
   const __m256 pv = _mm256_loadu_ps(p);
@@ -24,6 +17,12 @@ static inline __m256 complexProducts(const float* p, const float* q, __m256 sign
   const __m256 swapped = _mm256_permute_ps(pv, 0xB1);  // (pi, pr) pairs
   // Even lanes: pr qr + pi qi; odd lanes: pi qr - pr qi.
   return _mm256_fmsubadd_ps(pv, _mm256_moveldup_ps(qv), _mm256_mul_ps(swapped, _mm256_movehdup_ps(qv)));
+}
+
+// Each lane's squared magnitude of its complex value of four: re^2 + im^2 in both of its lanes.
+static inline __m256 pairNorms(__m256 v) {
+  const __m256 squares = _mm256_mul_ps(v, v);
+  return _mm256_add_ps(squares, _mm256_permute_ps(squares, 0xB1));
 }
 
 void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
@@ -54,21 +53,10 @@ void crossPowerRowAvx2(const float* p, const float* q, float* out, int count,
                                         odd_factor, odd_factor);
   for (; i + 4 <= count; i += 4) {
     const __m256 product = complexProducts(p + 2 * i, q + 2 * i, sign);
-    const __m256 squares = _mm256_mul_ps(product, product);
-    const __m256 norm = _mm256_add_ps(squares, _mm256_permute_ps(squares, 0xB1));
-    const __m256 scale = _mm256_div_ps(factors, _mm256_sqrt_ps(_mm256_add_ps(norm, tiny)));
+    const __m256 scale = _mm256_div_ps(factors, _mm256_sqrt_ps(_mm256_add_ps(pairNorms(product), tiny)));
     _mm256_storeu_ps(out + 2 * i, _mm256_mul_ps(product, scale));
   }
-  for (; i < count; ++i) {
-    const float pr = p[2 * i], pi = p[2 * i + 1];
-    const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
-    const float re = pr * qr + pi * qi;
-    const float im = pi * qr - pr * qi;
-    const float scale = ((i & 1) ? odd_factor : factor) /
-                        __builtin_sqrtf(re * re + im * im + kTinyMagnitudeSquared);
-    out[2 * i] = re * scale;
-    out[2 * i + 1] = im * scale;
-  }
+  for (; i < count; ++i) crossPowerElement(p, q, out, i, conjugate_sign, (i & 1) ? odd_factor : factor);
 }
 
 void crossPowerRowWeightedAvx2(const float* p, const float* q, float* out, int count,
@@ -82,30 +70,16 @@ void crossPowerRowWeightedAvx2(const float* p, const float* q, float* out, int c
   const __m256 pn = _mm256_set1_ps(p_noise), qn = _mm256_set1_ps(q_noise);
   const __m256 factors = _mm256_setr_ps(factor, factor, odd_factor, odd_factor, factor, factor,
                                         odd_factor, odd_factor);
-  // Each lane's squared magnitude of its complex value: (re^2 + im^2) in both lanes of a pair.
-  const auto norms = [](__m256 v) {
-    const __m256 squares = _mm256_mul_ps(v, v);
-    return _mm256_add_ps(squares, _mm256_permute_ps(squares, 0xB1));
-  };
   int i = 0;
   for (; i + 4 <= count; i += 4) {
     const __m256 product = complexProducts(p + 2 * i, q + 2 * i, sign);
-    const __m256 scale = _mm256_div_ps(factors, _mm256_sqrt_ps(_mm256_add_ps(norms(product), tiny)));
-    const __m256 wp = _mm256_max_ps(zero, _mm256_sub_ps(one, _mm256_div_ps(pn, _mm256_add_ps(norms(_mm256_loadu_ps(p + 2 * i)), tiny))));
-    const __m256 wq = _mm256_max_ps(zero, _mm256_sub_ps(one, _mm256_div_ps(qn, _mm256_add_ps(norms(_mm256_loadu_ps(q + 2 * i)), tiny))));
+    const __m256 scale = _mm256_div_ps(factors, _mm256_sqrt_ps(_mm256_add_ps(pairNorms(product), tiny)));
+    const __m256 wp = _mm256_max_ps(zero, _mm256_sub_ps(one, _mm256_div_ps(pn, _mm256_add_ps(pairNorms(_mm256_loadu_ps(p + 2 * i)), tiny))));
+    const __m256 wq = _mm256_max_ps(zero, _mm256_sub_ps(one, _mm256_div_ps(qn, _mm256_add_ps(pairNorms(_mm256_loadu_ps(q + 2 * i)), tiny))));
     _mm256_storeu_ps(out + 2 * i, _mm256_mul_ps(product, _mm256_mul_ps(scale, _mm256_mul_ps(wp, wq))));
   }
   for (; i < count; ++i) {
-    const float pr = p[2 * i], pi = p[2 * i + 1];
-    const float qr = q[2 * i], qi = conjugate_sign * q[2 * i + 1];
-    const float re = pr * qr + pi * qi;
-    const float im = pi * qr - pr * qi;
-    const float scale = ((i & 1) ? odd_factor : factor) /
-                        __builtin_sqrtf(re * re + im * im + kTinyMagnitudeSquared);
-    const float wp = __builtin_fmaxf(0.0f, 1.0f - p_noise / (pr * pr + pi * pi + kTinyMagnitudeSquared));
-    const float wq = __builtin_fmaxf(0.0f, 1.0f - q_noise / (qr * qr + qi * qi + kTinyMagnitudeSquared));
-    out[2 * i] = re * (scale * (wp * wq));
-    out[2 * i + 1] = im * (scale * (wp * wq));
+    weightedCrossPowerElement(p, q, out, i, conjugate_sign, (i & 1) ? odd_factor : factor, p_noise, q_noise);
   }
 }
 

@@ -162,15 +162,9 @@ std::string describeSizeMapping(const Intrinsics& calibration, cv::Size image_si
     return "";
   }
   const Intrinsics k = intrinsicsForImageSize(calibration, image_size);
-  // The crop intrinsicsForImageSize takes: the largest centred region of the images' aspect.
-  const double aspect = static_cast<double>(image_size.width) / image_size.height;
-  double crop_w = calibration.width, crop_h = calibration.height;
-  if (crop_w / crop_h > aspect) {
-    crop_w = crop_h * aspect;
-  } else {
-    crop_h = crop_w / aspect;
-  }
-  const cv::Size crop(static_cast<int>(std::lround(crop_w)), static_cast<int>(std::lround(crop_h)));
+  const cv::Size2d exact_crop = centredCropForImageSize(calibration, image_size);
+  const cv::Size crop(static_cast<int>(std::lround(exact_crop.width)),
+                      static_cast<int>(std::lround(exact_crop.height)));
   const bool cropped = crop.width != calibration.width || crop.height != calibration.height;
   return source + " describes a " + sizeText({calibration.width, calibration.height}) + " camera; the " +
          sizeText(image_size) + " images are taken as its " +

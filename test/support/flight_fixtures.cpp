@@ -79,5 +79,17 @@ const cv::Mat1f& flightTexture() {
   return texture;
 }
 
+void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,
+                     Trajectory& estimate, Trajectory& truth) {
+  StampedPose p;
+  p.stamp = static_cast<double>(index);
+  p.position = Eigen::Vector3d(estimated.x, estimated.y, estimated.z);
+  estimate.push_back(p);
+  StampedPose t;
+  t.stamp = p.stamp;
+  t.position = Eigen::Vector3d(true_pose.position[0], true_pose.position[1], true_pose.position[2]);
+  truth.push_back(t);
+}
+
 }  // namespace test
 }  // namespace oefmt

@@ -3,9 +3,14 @@
 // with the ground truth in the estimator's world conventions.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "oefmt/evaluation.h"
+#include "oefmt/sim/camera_model.h"
+#include "oefmt/trajectory.h"
 
 namespace oefmt {
 namespace test {
@@ -46,6 +51,11 @@ Flight renderTwoLayerFlight(const cv::Mat1f& ground, const cv::Mat1f& roofs, con
 
 /// The scene texture of the flight tests (2048 x 2048, cells, seeded).
 const cv::Mat1f& flightTexture();
+
+/// Appends frame `index`'s estimated position and the simulated flight's true one, both stamped
+/// with the index (for an evaluation that associates by index).
+void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,
+                     Trajectory& estimate, Trajectory& truth);
 
 }  // namespace test
 }  // namespace oefmt

@@ -10,6 +10,7 @@
 #include "oefmt/evaluation.h"
 #include "oefmt/sim/flight.h"
 #include "support/fixtures.h"
+#include "support/flight_fixtures.h"
 
 namespace oefmt {
 namespace {
@@ -54,15 +55,7 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
     const double rho = e->registration12.shift;
     if (k > 1 && previous_rho > 0.0 && std::fabs(rho / previous_rho - 1.0) > 0.1) ++run.hops;
     previous_rho = rho;
-    StampedPose p;
-    p.stamp = static_cast<double>(k);
-    p.position = Eigen::Vector3d(e->pose.x, e->pose.y, e->pose.z);
-    estimate.push_back(p);
-    StampedPose t;
-    t.stamp = p.stamp;
-    t.position = Eigen::Vector3d(plan.poses[k].position[0], plan.poses[k].position[1],
-                                 plan.poses[k].position[2]);
-    truth.push_back(t);
+    test::appendPositions(e->pose, plan.poses[k], k, estimate, truth);
   }
   EvaluationOptions options;
   options.association = AssociationMode::kIndex;

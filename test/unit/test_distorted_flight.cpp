@@ -18,6 +18,7 @@
 #include "oefmt/sim/renderer.h"
 #include "oefmt/sim/scene.h"
 #include "oefmt/undistortion.h"
+#include "support/flight_fixtures.h"
 
 namespace oefmt {
 namespace {
@@ -73,14 +74,7 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
       run.worst_heading_step = std::max(run.worst_heading_step, std::fabs(step_error));
     }
     previous_yaw = e->pose.yaw;
-    StampedPose p;
-    p.stamp = static_cast<double>(k);
-    p.position = Eigen::Vector3d(e->pose.x, e->pose.y, e->pose.z);
-    estimate.push_back(p);
-    StampedPose t;
-    t.stamp = p.stamp;
-    t.position = Eigen::Vector3d(plan.poses[k].position[0], plan.poses[k].position[1], plan.poses[k].position[2]);
-    truth.push_back(t);
+    test::appendPositions(e->pose, plan.poses[k], k, estimate, truth);
   }
   EvaluationOptions options;
   options.association = AssociationMode::kIndex;
