@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# Hardening checks (issue 6), separate from the main build. One clang++-14 build of fuzz/ (the
+# Hardening checks, separate from the main build. One clang++-14 build of fuzz/ (the
 # core instrumented with AddressSanitizer + UBSan and libFuzzer's coverage) gives:
 #   1. the unit tests under the sanitizers;
 #   2. the libFuzzer targets, each run for SECONDS on a copy of its seeds;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The estimator on rendered flights (spec section 8 items 10 and 11, issue 4 item 6).
+// The estimator on rendered flights: accuracy against their ground truth.
 // World units are ground texture pixels: altitude = fx = N (see flight_fixtures.h).
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Regressions for what the fuzz targets in fuzz/ found (issue 6): each input below once broke a
+// Regressions for what the fuzz targets in fuzz/ found: each input below once broke a
 // documented contract of the core.
 #include <gtest/gtest.h>
 
