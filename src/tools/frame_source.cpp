@@ -30,6 +30,7 @@ class FolderSource : public FrameSource {
   }
   std::string calibrationSource() const override { return "cam_param.yaml"; }
   cv::Size imageSize() override { return dataset_.imageSize(); }
+  std::vector<std::string> warnings() const override { return dataset_.warnings(); }
   std::string describe() const override {
     return dataset_.directory() + " (" + std::to_string(dataset_.size()) + " images " +
            std::to_string(dataset_.imageSize().width) + "x" +

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -44,6 +45,8 @@ class FrameSource {
   /// Size of the frames (the first one's; a bag decodes it ahead), empty when there is none.
   /// Called before the first next().
   virtual cv::Size imageSize() { return {}; }
+  /// What the source tolerated and the user should know (a timestamps.txt that was ignored).
+  virtual std::vector<std::string> warnings() const { return {}; }
   virtual std::string describe() const = 0;
 };
 

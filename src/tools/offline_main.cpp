@@ -163,6 +163,11 @@ int main(int argc, char** argv) {
             ? oefmt::openBag(options.bag, options.image_topic, options.camera_info_topic)
             : oefmt::openFolder(options.images);
     const std::string source_text = opened->describe();
+    // Whatever the source tolerated changes the result (without its timestamps.txt a folder's
+    // frames are a second apart, which widens the motion model's window): said even with --quiet.
+    for (const std::string& warning : opened->warnings()) {
+      std::fprintf(stderr, "oefmt_offline: warning: %s\n", warning.c_str());
+    }
     const cv::Size image_size = opened->imageSize();
     // The camera of the frames as registered: the calibration mapped to the images' size, the
     // lens distortion undone (the node sets up the same, so both register the same frames).

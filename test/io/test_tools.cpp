@@ -10,6 +10,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -311,6 +313,50 @@ TEST(Tools, OfflineWarnsWhenFramesAreUpscaled) {
                                       " --images " + (dir / "flight") + " --output " + (dir / "b.tum"));
   EXPECT_EQ(native.status, 0) << native.err;
   EXPECT_EQ(native.err.find("upscaled"), std::string::npos) << native.err;
+}
+
+// The first column of a TUM trajectory's poses.
+std::vector<double> trajectoryStamps(const std::string& path) {
+  std::vector<double> stamps;
+  std::istringstream lines(readFile(path));
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line));
+  }
+  return stamps;
+}
+
+// A folder's frames carry its timestamps.txt (the motion model needs the real frame interval);
+// a timestamps.txt that cannot be used is said, even with --quiet, and the frames are indexed.
+TEST(Tools, OfflineStampsFramesWithTimestampsAndSaysWhenItCannot) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight");
+  const ToolRun stamped = run(dir, offline + " --output " + (dir / "a.tum"));
+  ASSERT_EQ(stamped.status, 0) << stamped.err;
+  EXPECT_EQ(stamped.err.find("timestamps.txt"), std::string::npos) << stamped.err;
+  FolderDataset dataset(dir / "flight");
+  ASSERT_TRUE(dataset.hasTimestamps());
+  const std::vector<double> stamps = trajectoryStamps(dir / "a.tum");
+  ASSERT_EQ(stamps.size(), 3u);
+  for (std::size_t k = 0; k < stamps.size(); ++k) EXPECT_NEAR(stamps[k], dataset.timestamp(k), 1e-6) << k;
+  EXPECT_GT(stamps[1] - stamps[0], 0.0);
+  EXPECT_LT(stamps[1] - stamps[0], 0.9);  // the render's interval, not the index's second
+
+  const std::vector<std::pair<std::string, std::string>> broken = {
+      {"1.0\n1.2\n", "it has 2 stamps for 3 images"},
+      {"1.0\nsoon\n1.4\n", "line 2 'soon' is not a time"},
+      {"1.0\n1.4\n1.2\n", "stamps do not increase at line 3"}};
+  for (const auto& [text, message] : broken) {
+    {
+      std::ofstream file(dir / "flight/timestamps.txt");
+      file << text;
+    }
+    const ToolRun indexed = run(dir, offline + " --output " + (dir / "b.tum"));
+    ASSERT_EQ(indexed.status, 0) << indexed.err;
+    EXPECT_NE(indexed.err.find("warning: timestamps.txt ignored"), std::string::npos) << indexed.err;
+    EXPECT_NE(indexed.err.find(message), std::string::npos) << indexed.err;
+    EXPECT_EQ(trajectoryStamps(dir / "b.tum"), (std::vector<double>{0.0, 1.0, 2.0})) << message;
+  }
 }
 
 // OpenCV's imgcodecs (with GDAL and ~150 more libraries: 0.13 s of start-up, 40 MB) is loaded
