@@ -16,10 +16,10 @@
 #include <string>
 
 #include "fuzz_check.h"
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
-#include "oefmt/estimator_config.h"
-#include "oefmt/undistortion.h"
+#include "oefmt/estimation/estimator_config.h"
+#include "oefmt/io/undistortion.h"
 
 namespace {
 

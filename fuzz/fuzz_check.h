@@ -9,7 +9,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/registration.h"
+#include "oefmt/registration/registration.h"
 
 namespace oefmt_fuzz {
 

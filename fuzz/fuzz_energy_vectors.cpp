@@ -10,7 +10,7 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include "fuzz_check.h"
-#include "oefmt/pattern_matching.h"
+#include "oefmt/registration/pattern_matching.h"
 
 namespace {
 

@@ -16,9 +16,9 @@
 
 #include "fuzz_check.h"
 #include "oefmt/error.h"
-#include "oefmt/image_decoding.h"
-#include "oefmt/image_prep.h"
-#include "oefmt/registration.h"
+#include "oefmt/io/image_decoding.h"
+#include "oefmt/registration/image_prep.h"
+#include "oefmt/registration/registration.h"
 
 namespace {
 

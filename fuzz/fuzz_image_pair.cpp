@@ -14,7 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fuzz_check.h"
-#include "oefmt/registration.h"
+#include "oefmt/registration/registration.h"
 
 namespace {
 

@@ -4,7 +4,7 @@
 # core instrumented with AddressSanitizer + UBSan and libFuzzer's coverage) gives:
 #   1. the unit tests under the sanitizers;
 #   2. the libFuzzer targets, each run for SECONDS on a copy of its seeds;
-# and 3. the ROS-free core (src/core) through the aarch64 compiler's front end (ARM companion
+# and 3. the ROS-free libraries (src/registration, estimation, io, evaluation) through the aarch64 compiler's front end (ARM companion
 #    computers: the NEON paths; the AVX2 files are stubs there), warnings as errors.
 # (The catkin build can also be sanitised with gcc: -DOEFMT_SANITIZE=ON.)
 # Usage: bash scripts/hardening.sh BUILD_ROOT [SECONDS]   (SECONDS per fuzz target, default 20)
@@ -175,12 +175,12 @@ fi
 junit "$results/fuzz.xml" Fuzz "${cases[@]}"
 
 # ---------------------------------------------------------------------------------------------
-# 3. The core on ARM: every src/core file through the aarch64 compiler's front end (syntax and
+# 3. The core on ARM: every file of the ROS-free libraries through the aarch64 compiler's front end (syntax and
 #    semantics, front-end warnings; no code generation, which would double the time and could
 #    not be linked anyway: Debian has no aarch64 OpenCV/Ceres here). OpenCV's and Eigen's
 #    headers are the host's.
 # ---------------------------------------------------------------------------------------------
-section "Portability: src/core for aarch64 (g++ front end)"
+section "Portability: the ROS-free libraries for aarch64 (g++ front end)"
 arm="$root/aarch64"
 mkdir -p "$arm"
 cases=()
@@ -195,9 +195,10 @@ if command -v aarch64-linux-gnu-g++ >/dev/null; then
   }
   export -f compile_arm
   export repo arm
-  printf '%s\n' "$repo"/src/core/*.cpp | xargs -P "$jobs" -I{} bash -c 'compile_arm "$1"' _ {}
+  core_sources=("$repo"/src/{registration,estimation,io,evaluation}/*.cpp)
+  printf '%s\n' "${core_sources[@]}" | xargs -P "$jobs" -I{} bash -c 'compile_arm "$1"' _ {}
   compiled=0 sources=0
-  for source in "$repo"/src/core/*.cpp; do
+  for source in "${core_sources[@]}"; do
     name="$(basename "$source" .cpp)"
     sources=$((sources + 1))
     if [ "$(cat "$arm/$name.status" 2>/dev/null)" = 0 ]; then

@@ -13,8 +13,8 @@
 #include <sensor_msgs/distortion_models.h>
 
 #include "oefmt/error.h"
-#include "oefmt/image_decoding.h"
-#include "oefmt/image_encoding.h"
+#include "oefmt/io/image_decoding.h"
+#include "oefmt/io/image_encoding.h"
 
 namespace oefmt {
 namespace {

@@ -15,12 +15,12 @@
 
 #include "oefmt/EnergyVectors.h"
 #include "oefmt/error.h"
-#include "oefmt/image_prep.h"
+#include "oefmt/registration/image_prep.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/ros/estimate_messages.h"
 #include "oefmt/ros/parameter_yaml.h"
-#include "oefmt/trajectory.h"
-#include "oefmt/undistortion.h"
+#include "oefmt/estimation/pose.h"
+#include "oefmt/io/undistortion.h"
 
 namespace oefmt {
 namespace {

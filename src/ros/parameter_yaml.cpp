@@ -8,7 +8,7 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include "oefmt/error.h"
-#include "oefmt/yaml_map.h"
+#include "oefmt/io/yaml_map.h"
 
 namespace oefmt {
 namespace {

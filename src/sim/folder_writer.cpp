@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "oefmt/image_encoding.h"
+#include "oefmt/io/image_encoding.h"
 
 namespace oefmt {
 namespace sim {

@@ -5,10 +5,10 @@
 #include <cmath>
 
 
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
-#include "oefmt/image_decoding.h"
-#include "oefmt/image_prep.h"
+#include "oefmt/io/image_decoding.h"
+#include "oefmt/registration/image_prep.h"
 #include "oefmt/sim/texture.h"
 
 namespace oefmt {

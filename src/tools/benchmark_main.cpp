@@ -17,12 +17,12 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "oefmt/energy_vector.h"
-#include "oefmt/image_decoding.h"
-#include "oefmt/image_encoding.h"
-#include "oefmt/phase_correlation.h"
-#include "oefmt/registration.h"
-#include "oefmt/warp.h"
+#include "oefmt/registration/energy_vector.h"
+#include "oefmt/io/image_decoding.h"
+#include "oefmt/io/image_encoding.h"
+#include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/registration.h"
+#include "oefmt/registration/warp.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
 

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 #include "command_line.h"
 #include "oefmt/error.h"
-#include "oefmt/evaluation.h"
+#include "oefmt/evaluation/evaluation.h"
 
 extern char** environ;
 
@@ -152,8 +152,8 @@ int main(int argc, char** argv) {
 
   oefmt::EvaluationResult result;
   try {
-    const oefmt::Trajectory estimate = oefmt::readTum(paths[0]);
-    const oefmt::Trajectory truth = oefmt::readTum(paths[1]);
+    const oefmt::StampedTrajectory estimate = oefmt::readTum(paths[0]);
+    const oefmt::StampedTrajectory truth = oefmt::readTum(paths[1]);
     result = oefmt::evaluateTrajectory(estimate, truth, options);
     if (!aligned_path.empty()) {
       oefmt::writeTum(aligned_path, result.aligned_estimate, {"estimate of " + paths[0] + " aligned to " + paths[1]});

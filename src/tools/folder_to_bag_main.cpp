@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 #include "command_line.h"
 #include "oefmt/error.h"
 #include "oefmt/ros/bag_io.h"
-#include "oefmt/sim/progress.h"
+#include "progress.h"
 
 namespace {
 
@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
       std::printf("intrinsics  file %dx%d fx %.2f fy %.2f cx %.2f cy %.2f -> images fx %.3f fy %.3f cx %.3f cy %.3f\n",
                   file.width, file.height, file.fx, file.fy, file.cx, file.cy, k.fx, k.fy, k.cx, k.cy);
     }
-    oefmt::sim::ProgressBar progress("converting", dataset.size(), quiet ? nullptr : stderr);
+    oefmt::tools::ProgressBar progress("converting", dataset.size(), quiet ? nullptr : stderr);
     const std::size_t frames = oefmt::convertFolderToBag(dataset, paths[1], options,
                                                          [&](std::size_t k) { progress.update(k + 1); });
     progress.finish();

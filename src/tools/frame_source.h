@@ -17,8 +17,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/dataset.h"
-#include "oefmt/spectra.h"
+#include "oefmt/io/dataset.h"
+#include "oefmt/registration/spectra.h"
 
 namespace oefmt {
 

@@ -19,14 +19,14 @@
 #include "command_line.h"
 #include "frame_source.h"
 #include "oefmt/error.h"
-#include "oefmt/estimator.h"
-#include "oefmt/estimator_config.h"
-#include "oefmt/image_prep.h"
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/estimation/estimator_config.h"
+#include "oefmt/registration/image_prep.h"
 #include "oefmt/ros/bag_io.h"
-#include "oefmt/sim/progress.h"
-#include "oefmt/spectra.h"
-#include "oefmt/trajectory.h"
-#include "oefmt/undistortion.h"
+#include "progress.h"
+#include "oefmt/registration/spectra.h"
+#include "oefmt/io/tum.h"
+#include "oefmt/io/undistortion.h"
 
 namespace {
 
@@ -232,7 +232,7 @@ int main(int argc, char** argv) {
     const size_t total = options.max_frames >= 0
                              ? std::min<size_t>(source.source().size(), options.max_frames)
                              : source.source().size();
-    oefmt::sim::ProgressBar progress("oefmt_offline", total, options.quiet ? nullptr : stderr);
+    oefmt::tools::ProgressBar progress("oefmt_offline", total, options.quiet ? nullptr : stderr);
     oefmt::SourceFrame frame;
     while ((options.max_frames < 0 || frames < options.max_frames) && source.next(frame)) {
       if (!estimator) {

@@ -9,8 +9,8 @@
 
 
 #include "oefmt/error.h"
-#include "oefmt/image_decoding.h"
-#include "oefmt/registration.h"
+#include "oefmt/io/image_decoding.h"
+#include "oefmt/registration/registration.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
 

@@ -18,7 +18,7 @@
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/folder_writer.h"
-#include "oefmt/sim/progress.h"
+#include "progress.h"
 
 namespace {
 
@@ -384,7 +384,7 @@ int main(int argc, char** argv) {
                                           oefmt::sim::groundTruthHeader(plan));
     std::unique_ptr<oefmt::BagFlightWriter> bag;
     if (!command.bag.empty()) bag = std::make_unique<oefmt::BagFlightWriter>(command.bag, plan.camera, command.bag_options);
-    oefmt::sim::ProgressBar progress("rendering", plan.poses.size(), command.quiet ? nullptr : stderr);
+    oefmt::tools::ProgressBar progress("rendering", plan.poses.size(), command.quiet ? nullptr : stderr);
     // The written frames' contrast, as the estimator sees it (after sampling, noise and gain).
     double std_sum = 0.0, std_min = HUGE_VAL, std_max = 0.0;
     oefmt::sim::renderFlight(plan, [&](int k, const cv::Mat1b& image, const cv::Mat1b&) {

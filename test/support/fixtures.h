@@ -7,7 +7,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/registration.h"
+#include "oefmt/registration/registration.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/similarity_views.h"
 

@@ -80,7 +80,7 @@ const cv::Mat1f& flightTexture() {
 }
 
 void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,
-                     Trajectory& estimate, Trajectory& truth) {
+                     StampedTrajectory& estimate, StampedTrajectory& truth) {
   StampedPose p;
   p.stamp = static_cast<double>(index);
   p.position = Eigen::Vector3d(estimated.x, estimated.y, estimated.z);

@@ -8,9 +8,9 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/evaluation.h"
+#include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/camera_model.h"
-#include "oefmt/trajectory.h"
+#include "oefmt/estimation/pose.h"
 
 namespace oefmt {
 namespace test {
@@ -55,7 +55,7 @@ const cv::Mat1f& flightTexture();
 /// Appends frame `index`'s estimated position and the simulated flight's true one, both stamped
 /// with the index (for an evaluation that associates by index).
 void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,
-                     Trajectory& estimate, Trajectory& truth);
+                     StampedTrajectory& estimate, StampedTrajectory& truth);
 
 }  // namespace test
 }  // namespace oefmt

@@ -6,8 +6,8 @@
 
 #include <vector>
 
-#include "oefmt/estimator.h"
-#include "oefmt/evaluation.h"
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/flight.h"
 #include "support/fixtures.h"
 #include "support/flight_fixtures.h"
@@ -42,7 +42,7 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   config.altitude = plan.track.altitude;
   config.fx = plan.camera.intrinsics.fx;
   Estimator estimator(config);
-  Trajectory estimate, truth;
+  StampedTrajectory estimate, truth;
   FlightRun run;
   double previous_rho = 0.0;
   for (std::size_t k = 0; k < frames.size(); ++k) {

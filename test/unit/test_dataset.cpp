@@ -9,10 +9,10 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "io/temp_dir.h"
-#include "oefmt/dataset.h"
+#include "support/temp_dir.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
-#include "oefmt/evaluation.h"
+#include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/folder_writer.h"
 
@@ -244,7 +244,7 @@ TEST(Dataset, SimulatedFlightRoundTrip) {
   EXPECT_NEAR(dataset.intrinsics().fx, plan.camera.intrinsics.fx, 1e-6);
   EXPECT_NEAR(dataset.intrinsics().cx, plan.camera.intrinsics.cx, 1e-6);
   EXPECT_DOUBLE_EQ(dataset.distortion().k1, -0.05);
-  const Trajectory truth = readTum(dir / "groundtruth.tum");
+  const StampedTrajectory truth = readTum(dir / "groundtruth.tum");
   ASSERT_EQ(truth.size(), 4u);
   for (std::size_t k = 0; k < 4; ++k) {
     EXPECT_NEAR(dataset.timestamp(k), plan.stamps[k], 1e-6);

@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "oefmt/error.h"
-#include "oefmt/estimator.h"
-#include "oefmt/evaluation.h"
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
 #include "oefmt/sim/scene.h"
-#include "oefmt/undistortion.h"
+#include "oefmt/io/undistortion.h"
 #include "support/flight_fixtures.h"
 
 namespace oefmt {
@@ -59,7 +59,7 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   config.altitude = plan.track.altitude;
   config.fx = camera.workingFx();
   Estimator estimator(config);
-  Trajectory estimate, truth;
+  StampedTrajectory estimate, truth;
   FlightRun run;
   double previous_yaw = 0.0;
   for (std::size_t k = 0; k < frames.size(); ++k) {

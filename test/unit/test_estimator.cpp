@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "oefmt/error.h"
-#include "oefmt/estimator.h"
+#include "oefmt/estimation/estimator.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
 #include "support/fixtures.h"

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "oefmt/error.h"
-#include "oefmt/estimator_config.h"
-#include "oefmt/yaml_text.h"
+#include "oefmt/estimation/estimator_config.h"
+#include "oefmt/io/yaml_text.h"
 
 namespace oefmt {
 namespace {

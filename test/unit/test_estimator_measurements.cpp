@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The estimator's internal decisions on one pair's observations (src/core/estimator_measurements).
+// The estimator's internal decisions on one pair's observations (src/estimation/estimator_measurements).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "estimator_measurements.h"
+#include "estimation/estimator_measurements.h"
 
 namespace oefmt {
 namespace {

@@ -7,17 +7,17 @@
 #include <fstream>
 #include <random>
 
-#include "io/temp_dir.h"
-#include "oefmt/dataset.h"
+#include "support/temp_dir.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
-#include "oefmt/evaluation.h"
+#include "oefmt/evaluation/evaluation.h"
 
 namespace oefmt {
 namespace {
 
 // A closed wavy circle of n poses, 0.1 s apart, with some height change.
-Trajectory groundTruth(int n = 200) {
-  Trajectory truth;
+StampedTrajectory groundTruth(int n = 200) {
+  StampedTrajectory truth;
   for (int k = 0; k < n; ++k) {
     const double a = 2.0 * M_PI * k / (n - 1);
     StampedPose pose;
@@ -29,9 +29,9 @@ Trajectory groundTruth(int n = 200) {
   return truth;
 }
 
-Trajectory transformed(const Trajectory& in, double scale, const Eigen::Matrix3d& rotation,
+StampedTrajectory transformed(const StampedTrajectory& in, double scale, const Eigen::Matrix3d& rotation,
                        const Eigen::Vector3d& translation) {
-  Trajectory out = in;
+  StampedTrajectory out = in;
   for (StampedPose& pose : out) {
     pose.position = scale * (rotation * pose.position) + translation;
     pose.orientation = Eigen::Quaterniond(rotation) * pose.orientation;
@@ -40,9 +40,9 @@ Trajectory transformed(const Trajectory& in, double scale, const Eigen::Matrix3d
 }
 
 TEST(Evaluation, SimilarityCopyInThePlaneHasNoError) {
-  const Trajectory truth = groundTruth();
+  const StampedTrajectory truth = groundTruth();
   const Eigen::Matrix3d yaw = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Trajectory estimate = transformed(truth, 0.37, yaw, Eigen::Vector3d(5.0, -3.0, 2.0));
+  const StampedTrajectory estimate = transformed(truth, 0.37, yaw, Eigen::Vector3d(5.0, -3.0, 2.0));
   EvaluationOptions options;
   const EvaluationResult result = evaluateTrajectory(estimate, truth, options);
   EXPECT_EQ(result.matched, truth.size());
@@ -56,11 +56,11 @@ TEST(Evaluation, SimilarityCopyInThePlaneHasNoError) {
 }
 
 TEST(Evaluation, SimilarityCopyInSpaceHasNoErrorIn3d) {
-  const Trajectory truth = groundTruth();
+  const StampedTrajectory truth = groundTruth();
   const Eigen::Matrix3d rotation =
       (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(-1.1, Eigen::Vector3d::UnitZ()))
           .toRotationMatrix();
-  const Trajectory estimate = transformed(truth, 2.5, rotation, Eigen::Vector3d(1.0, 2.0, 3.0));
+  const StampedTrajectory estimate = transformed(truth, 2.5, rotation, Eigen::Vector3d(1.0, 2.0, 3.0));
   EvaluationOptions options;
   options.planar = false;
   EXPECT_LT(evaluateTrajectory(estimate, truth, options).ate.max, 1e-8);
@@ -69,8 +69,8 @@ TEST(Evaluation, SimilarityCopyInSpaceHasNoErrorIn3d) {
 }
 
 TEST(Evaluation, RigidAlignmentKeepsTheScaleError) {
-  const Trajectory truth = groundTruth();
-  const Trajectory estimate = transformed(truth, 1.1, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  const StampedTrajectory truth = groundTruth();
+  const StampedTrajectory estimate = transformed(truth, 1.1, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
   EvaluationOptions options;
   options.with_scale = false;
   const EvaluationResult rigid = evaluateTrajectory(estimate, truth, options);
@@ -81,8 +81,8 @@ TEST(Evaluation, RigidAlignmentKeepsTheScaleError) {
 }
 
 TEST(Evaluation, AddedNoiseGivesTheExpectedRmse) {
-  const Trajectory truth = groundTruth(4000);
-  Trajectory estimate = truth;
+  const StampedTrajectory truth = groundTruth(4000);
+  StampedTrajectory estimate = truth;
   std::mt19937 random(42);
   std::normal_distribution<double> noise(0.0, 0.1);
   for (StampedPose& pose : estimate) pose.position += Eigen::Vector3d(noise(random), noise(random), noise(random));
@@ -96,7 +96,7 @@ TEST(Evaluation, AddedNoiseGivesTheExpectedRmse) {
 
 TEST(Evaluation, ScaleErrorWithoutScaleAlignmentIsTenPercentDrift) {
   // A straight line walked 10 % too far: every displacement is 10 % long.
-  Trajectory truth, estimate;
+  StampedTrajectory truth, estimate;
   for (int k = 0; k <= 100; ++k) {
     StampedPose pose;
     pose.stamp = k;
@@ -117,8 +117,8 @@ TEST(Evaluation, ScaleErrorWithoutScaleAlignmentIsTenPercentDrift) {
 }
 
 TEST(Evaluation, AssociatesByTimeWithinTheToleranceOrByIndex) {
-  const Trajectory truth = groundTruth(50);
-  Trajectory estimate = truth;
+  const StampedTrajectory truth = groundTruth(50);
+  StampedTrajectory estimate = truth;
   for (StampedPose& pose : estimate) pose.stamp += 0.004;
   estimate.erase(estimate.begin() + 10);  // a dropped frame
   EXPECT_EQ(associateByTime(estimate, truth, 0.01).size(), 49u);
@@ -135,18 +135,18 @@ TEST(Evaluation, AssociatesByTimeWithinTheToleranceOrByIndex) {
 }
 
 TEST(Evaluation, RejectsDegenerateInput) {
-  const Trajectory truth = groundTruth(10);
-  Trajectory still = truth;
+  const StampedTrajectory truth = groundTruth(10);
+  StampedTrajectory still = truth;
   for (StampedPose& pose : still) pose.position = Eigen::Vector3d(1.0, 2.0, 3.0);
   EXPECT_THROW(evaluateTrajectory(still, truth, EvaluationOptions{}), InputError);
-  EXPECT_THROW(evaluateTrajectory(Trajectory(truth.begin(), truth.begin() + 1), truth, EvaluationOptions{}), InputError);
+  EXPECT_THROW(evaluateTrajectory(StampedTrajectory(truth.begin(), truth.begin() + 1), truth, EvaluationOptions{}), InputError);
 }
 
 TEST(Evaluation, RigidAlignmentOfACameraThatNeverMovedIsAShift) {
   // A spin in place: the truth stays at one point; so does a perfect estimate, elsewhere.
-  Trajectory truth = groundTruth(20);
+  StampedTrajectory truth = groundTruth(20);
   for (StampedPose& pose : truth) pose.position = Eigen::Vector3d(4.0, -2.0, 30.0);
-  Trajectory estimate = truth;
+  StampedTrajectory estimate = truth;
   for (StampedPose& pose : estimate) pose.position = Eigen::Vector3d(0.0, 0.0, 0.0);
   estimate[7].position = Eigen::Vector3d(0.3, 0.0, 0.0);  // one pose 0.3 m off the others
   EvaluationOptions options;
@@ -169,9 +169,9 @@ TEST(Evaluation, ErrorStatistics) {
 
 TEST(Evaluation, TumFilesRoundTripAndReportBadLines) {
   test::TempDir dir;
-  const Trajectory truth = groundTruth(20);
+  const StampedTrajectory truth = groundTruth(20);
   writeTum(dir / "a.tum", truth, {"a comment"});
-  const Trajectory read = readTum(dir / "a.tum");
+  const StampedTrajectory read = readTum(dir / "a.tum");
   ASSERT_EQ(read.size(), truth.size());
   for (std::size_t k = 0; k < read.size(); ++k) {
     EXPECT_NEAR(read[k].stamp, truth[k].stamp, 1e-6);
@@ -189,9 +189,9 @@ TEST(Evaluation, TumFilesRoundTripAndReportBadLines) {
 }
 
 TEST(Evaluation, HeadingStepErrorsCountTheStepsOffByMoreThanTheThreshold) {
-  const Trajectory truth = groundTruth(50);
+  const StampedTrajectory truth = groundTruth(50);
   // A constant yaw offset (any alignment) changes no step; turns added at two frames do.
-  Trajectory estimate = transformed(truth, 1.0, Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+  StampedTrajectory estimate = transformed(truth, 1.0, Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
                                     Eigen::Vector3d::Zero());
   const auto turn = [&](std::size_t from, double radians) {
     for (std::size_t k = from; k < estimate.size(); ++k) {
@@ -214,7 +214,7 @@ TEST(Evaluation, HeadingStepErrorsCountTheStepsOffByMoreThanTheThreshold) {
 }
 
 TEST(Evaluation, JsonLineHasEveryFigure) {
-  const Trajectory truth = groundTruth(30);
+  const StampedTrajectory truth = groundTruth(30);
   EvaluationOptions options;
   const EvaluationResult result = evaluateTrajectory(truth, truth, options);
   const std::string json = evaluationJson(result, options);

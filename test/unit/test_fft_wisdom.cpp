@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "io/temp_dir.h"
-#include "oefmt/fft.h"
+#include "support/temp_dir.h"
+#include "oefmt/registration/fft.h"
 
 namespace oefmt {
 namespace {

@@ -10,12 +10,12 @@
 
 #include <opencv2/core.hpp>
 
-#include "io/temp_dir.h"
-#include "oefmt/dataset.h"
+#include "support/temp_dir.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
-#include "oefmt/estimator_config.h"
-#include "oefmt/image_prep.h"
-#include "oefmt/registration.h"
+#include "oefmt/estimation/estimator_config.h"
+#include "oefmt/registration/image_prep.h"
+#include "oefmt/registration/registration.h"
 #include "support/fixtures.h"
 
 namespace oefmt {

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "oefmt/error.h"
-#include "oefmt/registration.h"
+#include "oefmt/registration/registration.h"
 #include "support/fixtures.h"
 
 namespace oefmt {

@@ -14,7 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
-#include "oefmt/image_decoding.h"
+#include "oefmt/io/image_decoding.h"
 
 namespace oefmt {
 namespace {

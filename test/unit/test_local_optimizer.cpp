@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "oefmt/local_optimizer.h"
+#include "oefmt/estimation/local_optimizer.h"
 
 namespace oefmt {
 namespace {

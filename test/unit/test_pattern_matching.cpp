@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "oefmt/pattern_matching.h"
+#include "oefmt/registration/pattern_matching.h"
 #include "oefmt/sim/texture.h"
 #include "support/fixtures.h"
 

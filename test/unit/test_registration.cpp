@@ -8,8 +8,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
-#include "oefmt/image_prep.h"
-#include "oefmt/registration.h"
+#include "oefmt/registration/image_prep.h"
+#include "oefmt/registration/registration.h"
 #include "oefmt/sim/texture.h"
 #include "support/fixtures.h"
 

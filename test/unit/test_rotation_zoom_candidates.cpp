@@ -6,7 +6,7 @@
 #include <cmath>
 #include <memory>
 
-#include "oefmt/registration.h"
+#include "oefmt/registration/registration.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
 #include "support/fixtures.h"

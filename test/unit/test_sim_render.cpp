@@ -9,8 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "io/temp_dir.h"
-#include "oefmt/dataset.h"
+#include "support/temp_dir.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
 
 #include "oefmt/sim/flight.h"

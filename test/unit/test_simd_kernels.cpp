@@ -7,12 +7,12 @@
 #include <algorithm>
 #include <cmath>
 
-#include "oefmt/fft.h"
-#include "oefmt/phase_correlation.h"
-#include "oefmt/config.h"
+#include "oefmt/registration/fft.h"
+#include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/registration_config.h"
 #include "oefmt/error.h"
-#include "oefmt/spectra.h"
-#include "simd_kernels.h"
+#include "oefmt/registration/spectra.h"
+#include "registration/simd_kernels.h"
 
 namespace oefmt {
 namespace {

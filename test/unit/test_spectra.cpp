@@ -7,10 +7,10 @@
 #include <limits>
 
 #include "oefmt/error.h"
-#include "oefmt/fft.h"
-#include "oefmt/phase_correlation.h"
-#include "oefmt/spectra.h"
-#include "oefmt/warp.h"
+#include "oefmt/registration/fft.h"
+#include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/spectra.h"
+#include "oefmt/registration/warp.h"
 #include "support/fixtures.h"
 
 namespace oefmt {

@@ -16,7 +16,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/sim/camera_model.h"
-#include "oefmt/undistortion.h"
+#include "oefmt/io/undistortion.h"
 
 namespace oefmt {
 namespace {

@@ -9,7 +9,7 @@
 #include <thread>
 #include <vector>
 
-#include "worker_thread.h"
+#include "estimation/worker_thread.h"
 
 namespace oefmt {
 namespace {

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "oefmt/error.h"
-#include "oefmt/yaml_map.h"
+#include "oefmt/io/yaml_map.h"
 
 namespace oefmt {
 namespace {

@@ -15,7 +15,7 @@
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 
 namespace oefmt {
 

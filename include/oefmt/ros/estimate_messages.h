@@ -10,7 +10,7 @@
 #include <std_msgs/Header.h>
 
 #include "oefmt/EnergyVectors.h"
-#include "oefmt/estimator.h"
+#include "oefmt/estimation/estimator.h"
 
 namespace oefmt {
 

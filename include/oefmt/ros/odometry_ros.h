@@ -28,11 +28,11 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "oefmt/estimator.h"
-#include "oefmt/estimator_config.h"
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/estimation/estimator_config.h"
 #include "oefmt/ros/frame_queue.h"
-#include "oefmt/stamp_guard.h"
-#include "oefmt/undistortion.h"
+#include "oefmt/ros/stamp_guard.h"
+#include "oefmt/io/undistortion.h"
 
 namespace oefmt {
 

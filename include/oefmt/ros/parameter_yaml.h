@@ -7,7 +7,7 @@
 
 #include <ros/node_handle.h>
 
-#include "oefmt/estimator_config.h"
+#include "oefmt/estimation/estimator_config.h"
 
 namespace oefmt {
 

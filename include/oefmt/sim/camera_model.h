@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 
 namespace oefmt {
 namespace sim {

@@ -8,8 +8,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/dataset.h"
-#include "oefmt/evaluation.h"
+#include "oefmt/io/dataset.h"
+#include "oefmt/io/tum.h"
 #include "oefmt/sim/camera_model.h"
 
 namespace oefmt {
@@ -39,7 +39,7 @@ class FolderFlightWriter {
   int digits_;
   std::vector<std::string> header_;
   std::vector<std::string> names_;
-  Trajectory truth_;
+  StampedTrajectory truth_;
 };
 
 }  // namespace sim

@@ -8,7 +8,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "oefmt/dataset.h"
+#include "oefmt/io/dataset.h"
 #include "oefmt/sim/camera_model.h"
 #include "oefmt/sim/scene.h"
 

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Parameters of the estimator, loaded from one YAML file (config/default.yaml documents every
+// key) by the offline tools and, as private parameters, by the ROS node.
+#pragma once
+
+#include <string>
+
+#include "oefmt/registration/registration_config.h"
+#include "oefmt/estimation/local_optimizer.h"
+#include "oefmt/io/yaml_map.h"
+
+namespace oefmt {
+
+/// Which method turns frames into motion (the paper's comparison).
+enum class EstimatorMode {
+  kOefmt,  ///< o-eFMT: energy vectors, three-frame window, pattern matching, local optimizer
+  kEfmt,   ///< original eFMT: multi-zoom translation profiles, consecutive pairs, PMT scale chain
+  kFmt,    ///< classic FMT: single peaks, consecutive pairs
+};
+const char* toString(EstimatorMode mode);
+/// "oefmt", "efmt" or "fmt"; throws InputError otherwise.
+EstimatorMode parseEstimatorMode(const std::string& text);
+
+/// Pattern matching of energy vectors (spec 2.8).
+struct MatchingConfig {
+  int stretch_steps = 100;            ///< PMT candidates exp(m key / 1000), m = -steps..steps
+  double stretch_key_12 = 16.0;       ///< candidate spacing of PMT 0-1 vs 1-2 [per mille of ln]
+  double stretch_key_02 = 13.0;       ///< candidate spacing of PMT 0-1 vs 0-2 [per mille of ln]
+  double stretch_init_window = 0.6;   ///< PMT factors must lie within this of the expected one
+  double max_normalised_error = 0.22; ///< qualifying error, relative to the error range
+  double smoothing_sigma = 1.0;       ///< Gaussian smoothing of the vectors [bins], 0 = off
+  double stretch_sigma_floor = 0.002; ///< smallest PMT sigma (relative)
+  double shift_range = 25.5;          ///< PMS search range [bins]
+  double shift_step = 0.04;           ///< PMS resolution [bins]
+  double shift_sigma_floor = 0.04;    ///< smallest PMS sigma [bins]
+  double min_peak_bins = 4.0;         ///< PMT needs the 0-1 shift beyond this many T bins
+  /// T bins cleared before PMT when the 0-1 shift is beyond 4x as many: the no-motion peak of a
+  /// static pattern must not decide the stretch.
+  int skip_bins = 5;
+
+  void validate() const;
+};
+
+/// Layer following and failure handling of the estimator.
+struct TrackingConfig {
+  /// Relative difference between the correlation peak's shift and the PMT prediction beyond which
+  /// the peak is taken for another depth layer (or an alias) and only its direction is used.
+  double layer_gate = 0.05;
+  /// Relative window around the PMT prediction where the followed layer's T peak is searched.
+  double layer_search = 0.15;
+  /// A followed-layer peak must reach this fraction of the translation energy maximum.
+  double layer_min_fraction = 0.01;
+  /// A step off steady speed is moved to a translation energy peak at the steady length when
+  /// that peak reaches this fraction of the maximum (see steadyLayerStep).
+  double steady_layer_min_fraction = 0.05;
+  /// Consecutive frames that may fail to register before the window restarts from the newest.
+  int max_failed_frames = 3;
+  /// While frames fail, predict the pose with the last motion (else hold it).
+  bool predict_failed_frames = true;
+  /// Sigma of a predicted step relative to the step (and rotation 0.05 rad, ln zoom 0.05 added).
+  double prediction_sigma = 0.5;
+  /// Weak robust prior that d12 and d02 continue pair 0-1's motion (per frame interval), with this
+  /// sigma relative to the predicted length (+1 px); it breaks the tie when one pair's correlation
+  /// peak is an alias and its loop partner has no pattern match. 0 = off.
+  double motion_prior_sigma = 0.3;
+  /// Largest acceleration of the vehicle [m/s^2]. The motion so far predicts where the next
+  /// pair's translation peak lies; the window around that prediction is how far the vehicle can
+  /// depart from it between two frames (fx a dt^2 / altitude pixels). A weaker peak inside the
+  /// window is accepted where a peak anywhere in the image would not be, and the highest peak
+  /// outside the window and off the direction of motion (a repetitive texture's alias) is not
+  /// taken at full confidence.
+  double max_acceleration = 10.0;
+  /// Distance to the scene [m] the acceleration window assumes when the altitude is unknown:
+  /// low on purpose, which makes the window wide rather than wrong.
+  double assumed_altitude = 5.0;
+
+  void validate() const;
+};
+
+/// The registration's sigmas are peak widths; their errors are a fraction of that (measured for
+/// the energy-vector registration on rendered pairs at N = 256 and 512 and on a simulated
+/// multi-depth flight). These factors turn widths into 1-sigma errors before the measurements are
+/// weighted against each other and propagated into the pose covariance.
+struct UncertaintyConfig {
+  double rotation_scale = 0.25;  ///< theta error / rotation_sigma
+  double log_zoom_scale = 0.08;  ///< ln s error / log_zoom_sigma
+  double shift_scale = 0.1;      ///< error along d / shift_sigma
+  double direction_scale = 0.3;  ///< error across d / (shift * direction_sigma)
+
+  void validate() const;
+};
+
+/// The original eFMT's multi-zoom translation (spec 2.9b).
+struct EfmtConfig {
+  int zoom_samples = 5;          ///< zooms sampled between the least and most significant
+  double zoom_threshold = 0.2;   ///< significant: zoom energy above this fraction of its peak
+  int sector_half_width = 4;     ///< direction sector: rows on each side of the best row
+
+  void validate() const;
+};
+
+/// Every parameter of the estimator.
+struct EstimatorConfig {
+  EstimatorMode mode = EstimatorMode::kOefmt;
+  /// Altitude of the first frame above the dominant plane [m]; 0 = unknown (poses in units of
+  /// the initial altitude).
+  double altitude = 0.0;
+  /// Focal length in pixels of the working image (registration.size); 0 = assume size (a 53 deg
+  /// field of view). Scale the camera's fx by size / min(width, height) (scaleIntrinsics).
+  double fx = 0.0;
+  /// Run the two registrations of a frame (1-2 and 0-2) on two threads (the second core).
+  bool parallel_registrations = true;
+  RegistrationConfig registration;
+  MatchingConfig matching;
+  LocalOptimizerOptions optimizer;
+  TrackingConfig tracking;
+  UncertaintyConfig uncertainty;
+  EfmtConfig efmt;
+
+  /// fx, or the working size when fx is 0.
+  double effectiveFx() const { return fx > 0.0 ? fx : registration.size; }
+  /// Z_0 in output units: the altitude, or 1 when unknown.
+  double initialAltitude() const { return altitude > 0.0 ? altitude : 1.0; }
+  /// Throws InputError naming the first invalid field.
+  void validate() const;
+};
+
+/// Reads a YAML file of parameters (parseYaml: maps of scalars; a leading "%YAML" directive
+/// and "---" are optional). Missing keys keep their defaults; unknown keys and bad values throw
+/// InputError naming the key (e.g. "registration.size") and the rule. The result is validated.
+EstimatorConfig loadConfig(const std::string& yaml_path);
+/// The same from parsed YAML; `source` names it in error messages.
+EstimatorConfig parseConfig(const YamlNode& root, const std::string& source);
+/// Every parameter as YAML text that loadConfig reads back (for logging the effective values).
+std::string configToYaml(const EstimatorConfig& config);
+
+}  // namespace oefmt

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// 4-DOF poses of the camera (x, y, z, yaw) accumulated from pair motions (spec section 5, FIX).
+#pragma once
+
+#include <array>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "oefmt/estimation/pair_motion.h"
+
+namespace oefmt {
+
+/// A camera pose in the world frame (REP-103, right-handed, z up). The world frame is the first
+/// frame's footprint: x = right in the first image (east), y = up in the first image (north),
+/// z = up; its origin is the first camera position. yaw turns the camera counter-clockwise seen
+/// from above (0 = the first frame's heading). Units: metres when the initial altitude is known,
+/// otherwise units of the initial altitude (initial altitude = 1).
+struct Pose4 {
+  double stamp = 0.0;  ///< [s]
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;      ///< height above the first camera position
+  double yaw = 0.0;    ///< [rad], wrapped to (-pi, pi]
+  /// Covariance of (x, y, z, yaw), first order from the pair sigmas; zero at the origin.
+  cv::Matx44d covariance = cv::Matx44d::zeros();
+
+  bool finite() const;
+};
+
+/// The covariance as a row-major 6x6 over (x, y, z, roll, pitch, yaw), as nav_msgs/Odometry
+/// wants it. Roll and pitch are not observed (the camera is assumed level): they get
+/// `unobserved_variance`. Every diagonal entry is at least `min_variance` (never publish zeros).
+std::array<double, 36> covariance6x6(const Pose4& pose, double unobserved_variance = 1e6,
+                                     double min_variance = 1e-9);
+
+/// Unit quaternion (qx, qy, qz, qw) of a rotation by yaw about z.
+std::array<double, 4> yawQuaternion(double yaw);
+
+/// Accumulates pair motions into poses (spec 5, FIX): with psi the heading in the first image's
+/// axes (psi = -yaw) and Z the altitude above the reference plane,
+///   psi_k = wrap(psi_{k-1} + theta),  Z_k = Z_{k-1} / s,
+///   step  = -(Z_k / fx) R(psi_k) d   in first-image axes (y down): the camera moves opposite to
+///   the content, by the content shift scaled from pixels at altitude Z_k to world units;
+/// the step's y is flipped into the world's y (north = up in the image), z = Z_k - Z_0.
+class PoseIntegrator {
+ public:
+  /// initial_altitude: Z_0 above the dominant plane in output units (the altitude in metres, or 1
+  /// when unknown); fx: focal length in pixels of the working image. Throws InputError unless
+  /// both are finite and > 0.
+  PoseIntegrator(double initial_altitude, double fx);
+
+  /// Back to the origin with zero covariance.
+  void reset(double stamp);
+  /// Adds the motion from the previous frame to this one; returns the new pose.
+  const Pose4& integrate(const PairMotion& step, double stamp);
+  /// Keeps the pose (no usable motion for this frame) and adds `extra_covariance`.
+  const Pose4& hold(double stamp, const cv::Matx44d& extra_covariance);
+  /// Goes back to an earlier pose (e.g. undoing predictions once the real motion is known).
+  void restore(const Pose4& pose) { pose_ = pose; }
+  /// The covariance the last integrate() or hold() added to the pose (x, y, z, yaw): the
+  /// uncertainty of that one step alone, in the world frame and output units.
+  const cv::Matx44d& lastStepCovariance() const { return last_step_covariance_; }
+
+  const Pose4& pose() const { return pose_; }
+  /// Z_k: current altitude above the reference plane (output units).
+  double altitude() const { return initial_altitude_ + pose_.z; }
+  double initialAltitude() const { return initial_altitude_; }
+  double fx() const { return fx_; }
+
+ private:
+  double initial_altitude_;
+  double fx_;
+  Pose4 pose_;
+  cv::Matx44d last_step_covariance_ = cv::Matx44d::zeros();
+};
+
+}  // namespace oefmt

@@ -1,0 +1,193 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Spectral registration of an image pair: rotation, zoom, translation and their energy vectors.
+#pragma once
+
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "oefmt/registration/registration_config.h"
+#include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/spectra.h"
+
+namespace oefmt {
+
+enum class RegistrationMethod {
+  kEnergyVectors,  ///< o-eFMT: Gaussian-fused zoom and translation energy vectors
+  kClassic,        ///< Reddy-Chatterji FMT: single peaks only, no energy vectors
+};
+
+enum class RegistrationStatus {
+  kOk,             ///< sharp peaks, usable
+  kLowConfidence,  ///< computed, but the peaks are weak (little overlap, blur, noise)
+  kTextureless,    ///< a frame is constant, black or saturated: nothing was estimated
+};
+const char* toString(RegistrationStatus status);
+
+/// The registration of an older frame A to a newer frame B.
+/// Axes: x right, y down (image). Angles: atan2(dy, dx) in these axes.
+struct PairRegistration {
+  RegistrationStatus status = RegistrationStatus::kTextureless;
+  double rotation = 0.0;     ///< theta [rad]: B is A rotated counter-clockwise on screen, (-pi, pi]
+  double zoom = 1.0;         ///< s: B looks s times larger than A
+  cv::Point2d translation;   ///< d [px]: shift of B's content after A is rotated+zoomed onto B
+  double direction = 0.0;    ///< phi = atan2(d.y, d.x) [rad]
+  double shift = 0.0;        ///< rho = |d| [px], the dominant depth's shift
+  double rotation_sigma = 0.0;   ///< [rad]
+  double log_zoom_sigma = 0.0;   ///< sigma of ln(s)
+  double direction_sigma = 0.0;  ///< [rad]
+  double shift_sigma = 0.0;      ///< [px]
+  std::vector<float> zoom_energy;         ///< S: bin j <-> ln(s) = -(j - N/2) ln(b); empty in classic
+  std::vector<float> translation_energy;  ///< T: bin j <-> shift j * polarRadiusStep(); empty in classic
+  double rotation_zoom_peak = 0.0;  ///< height of the rotation/zoom correlation peak (0..1)
+  double translation_peak = 0.0;    ///< height of the translation correlation peak (0..1)
+  double confidence = 0.0;          ///< 0 (unusable) .. 1, from both peak-to-sidelobe ratios
+  /// Which rotation/zoom peak registered: 0 the first tried (the prior's window, if any, else the
+  /// highest), 1.. the next highest; kPredicted: none, the prior's rotation and zoom were used.
+  int rotation_zoom_candidate = 0;
+  static constexpr int kPredicted = -1;
+  bool half_turn = false;           ///< the 180-degree alternative won
+  /// The translation peak came from the prior's window, not the surface's highest peak (which
+  /// was off the predicted motion or too weak).
+  bool translation_from_window = false;
+  /// The surface's highest peak was off the predicted motion and nothing in the window stood
+  /// out: the registration is not confident.
+  bool translation_implausible = false;
+  /// With a predicted translation: the peak the prediction points at (the highest within its
+  /// window, weighted towards the prediction) [px of B], and its confidence as a peak of that
+  /// window (0 when none stood out). The followed depth layer's, when another layer's peak is
+  /// the highest.
+  cv::Point2d followed_translation;
+  double followed_confidence = 0.0;
+  /// The rotation or zoom lay outside the prior's window: not confident, whatever the peaks.
+  bool rotation_zoom_implausible = false;
+  /// The older frame was warped before the translation correlation (false: the rotation/zoom
+  /// moved no pixel by more than identity_warp_px and its cached spectrum served).
+  bool warped = true;
+
+  bool usable() const { return status == RegistrationStatus::kOk; }
+};
+
+/// What the motion so far predicts for a pair's rotation and zoom. The rotation/zoom surface's
+/// highest values within the window are tried, and last the predicted rotation and zoom
+/// themselves: low overlap, weak texture and repetitive patterns weaken the true rotation/zoom
+/// peak long before the translation peak, and another peak can be the highest. A result
+/// outside the window (a half turn) is ruled out. A registration on the predicted values
+/// (rotation_zoom_candidate kPredicted) measured only the translation; its rotation and zoom
+/// carry the prediction's sigmas.
+struct RegistrationPrior {
+  double rotation = 0.0;         ///< predicted theta [rad]
+  double log_zoom = 0.0;         ///< predicted ln s
+  double rotation_sigma = 0.0;   ///< 1-sigma of the prediction [rad]
+  double log_zoom_sigma = 0.0;   ///< 1-sigma of the prediction [ln s]
+  double rotation_window = 0.0;  ///< half width of the window [rad]
+  double log_zoom_window = 0.0;  ///< half width of the window [ln s]
+  /// How closely the motion so far pins the rotation and zoom [rad, ln s]: within the window a
+  /// peak's height is weighted by a Gaussian of these widths around the prediction, so that a
+  /// nearby peak of another surface (an inclined plane, whose perspective reads as a turn and a
+  /// zoom) wins only by being much higher. 0: unweighted.
+  double rotation_spread = 0.0;
+  double log_zoom_spread = 0.0;
+  /// Predicted translation d [px of the newer frame] of the followed depth layer and the radius
+  /// of the window around it [px]; radius 0: no translation prediction. The highest translation
+  /// peak stands when it lies in the window or on the predicted direction of motion (another
+  /// depth layer moves along it, up to twice or half as far). Otherwise, and when it is too weak,
+  /// the highest peak within the window is taken if it stands out from the surface as a peak
+  /// that could be anywhere in a window of that size would have to; if none does, the
+  /// registration is not confident (a repetitive texture's alias, or a pair that does not match).
+  cv::Point2d translation;
+  double translation_radius = 0.0;
+  /// How far the last steps strayed from the prediction's constant motion [px]: its own
+  /// uncertainty, without the vehicle's possible acceleration.
+  double translation_sigma = 0.0;
+};
+
+/// Correlation surfaces of the last registration, for diagnostics and plots.
+struct RegistrationSurfaces {
+  cv::Mat1f rotation_zoom;      ///< rows: rotation, columns: log-zoom (centred)
+  cv::Mat1f translation;        ///< centred Cartesian translation surface
+  cv::Mat1f translation_polar;  ///< rows: direction, columns: radius (energy-vector method only):
+                                ///< the band of rows around the peak direction that was unwrapped
+  int translation_polar_first_row = 0;  ///< direction row of translation_polar's first row
+};
+
+/// Registers frame pairs. Holds per-thread scratch buffers, so use one Registrar per thread;
+/// several Registrars can share one SpectralContext (FFT plans and tables).
+class Registrar {
+ public:
+  explicit Registrar(const RegistrationConfig& config);
+  explicit Registrar(std::shared_ptr<const SpectralContext> context);
+
+  /// Spectra of a camera image of any size and supported type (see prepareImage).
+  FrameSpectra analyse(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr);
+  /// Spectra of an already prepared N x N image.
+  FrameSpectra analyse(const PreparedImage& image);
+
+  /// Registers older -> newer. Throws InputError if a frame is empty or the sizes differ.
+  PairRegistration registerPair(const FrameSpectra& older, const FrameSpectra& newer,
+                                RegistrationMethod method = RegistrationMethod::kEnergyVectors,
+                                RegistrationSurfaces* surfaces = nullptr,
+                                const RegistrationPrior* prior = nullptr);
+
+  const SpectralContext& context() const { return *context_; }
+  std::shared_ptr<const SpectralContext> sharedContext() const { return context_; }
+  /// ln(b): change of ln(zoom) per zoom-energy bin.
+  double logZoomPerBin() const;
+  /// Pixels of shift per translation-energy bin.
+  double shiftPerBin() const { return context_->polarRadiusStep(); }
+  /// Rotation/zoom peaks this Registrar tries (default: the configuration's
+  /// rotation_zoom_candidates); clamped to >= 1.
+  void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
+
+ private:
+  // The rotation/zoom correlation surface of the pair, into rotation_zoom_surface_.
+  void correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer);
+  // Rotation, zoom, translation and confidence with the given peak of the rotation/zoom
+  // surface. The prior's translation, if any, guides the translation peak.
+  void registerOnce(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
+                    PairRegistration& result, const SurfacePeak& rotation_zoom_peak,
+                    RegistrationSurfaces* surfaces, const RegistrationPrior* prior);
+  // The registration with the peaks of the prior's window (see RegistrationPrior).
+  PairRegistration registerInWindow(const FrameSpectra& older, const FrameSpectra& newer,
+                                    RegistrationMethod method, const RegistrationPrior& prior,
+                                    RegistrationSurfaces* surfaces);
+  // Each returns the peak-to-sidelobe ratio of its correlation surface.
+  double registerRotationZoom(RegistrationMethod method, PairRegistration& result,
+                              const SurfacePeak& peak);
+  // The rotation/zoom surface's position of the prior's prediction (x = column, y = row).
+  cv::Point2d windowCentre(const RegistrationPrior& window) const;
+  // The highest peak of the rotation/zoom surface within the prior's window, weighted towards
+  // the prediction (findPeakInWindow), other than the peak at `exclude`.
+  SurfacePeak windowPeak(const RegistrationPrior& window, cv::Point exclude = {-10, -10}) const;
+  // That Gaussian weight of a surface position.
+  double windowWeight(const RegistrationPrior& window, cv::Point peak) const;
+  // The translation alone, with the prior's rotation and zoom.
+  void registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
+                       const RegistrationPrior& prior, PairRegistration& result,
+                       RegistrationSurfaces* surfaces);
+  // The translation's confidence (0..1) instead of a peak-to-sidelobe ratio.
+  double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
+                             RegistrationMethod method, PairRegistration& result,
+                             bool test_half_turn, const RegistrationPrior* prior);
+  // The translation peak of surface_: the highest, or the prior's window's; sets the result's
+  // window flags and returns the peak's confidence.
+  double chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
+                               PairRegistration& result);
+
+  std::shared_ptr<const SpectralContext> context_;
+  SpectraBuilder builder_;
+  // Scratch, reused across calls.
+  cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
+  cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)
+  cv::Mat1f rotation_zoom_surface_;  // a view of rotation_zoom_power_
+  SurfaceStats rotation_zoom_stats_;  // of the whole surface, for the peak-to-sidelobe ratios
+  SurfacePeak rotation_zoom_highest_;
+  cv::Mat1f small_surface_, polar_;
+  cv::Mat2f warped_spectrum_;
+  int polar_first_row_ = 0;
+  int rotation_zoom_candidates_;
+};
+
+}  // namespace oefmt

@@ -1,0 +1,690 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/estimation/estimator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <deque>
+#include <cmath>
+#include <exception>
+#include <future>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "estimator_measurements.h"
+#include "oefmt/error.h"
+#include "oefmt/estimation/multi_zoom.h"
+#include "worker_thread.h"
+
+namespace oefmt {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using detail::alongTrackSigma;
+using detail::kMinShiftSigma;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Growth of a held pose per frame, relative to the altitude (x, y, z) and in rad (yaw): large on
+// purpose, the camera may have moved anywhere.
+constexpr double kHeldPositionSigma = 0.1;
+constexpr double kHeldAltitudeSigma = 0.05;
+constexpr double kHeldYawSigma = 0.1;
+// Extra sigmas of a predicted step's rotation [rad] and log-zoom.
+constexpr double kPredictedRotationSigma = 0.05;
+constexpr double kPredictedLogZoomSigma = 0.05;
+
+// Half width of the window where a pair's rotation/zoom peak is searched first [surface bins;
+// at N = 512 one rotation bin is 0.35 deg, one zoom bin 1.1 %], plus three sigmas of the
+// prediction. A yaw or climb rate that changes by more within one frame interval is still found
+// by the search of the whole surface that follows.
+constexpr double kPriorWindowBins = 6.0;
+// Steps whose median predicts the next rotation and zoom: a yaw or climb rate that changes
+// shows in the median after two steps, a single wrong step not at all.
+constexpr std::size_t kPredictionSteps = 3;
+// Smallest radius of the translation window [px]: sub-pixel noise and rounding.
+constexpr double kTranslationWindowFloor = 2.0;
+
+// Pair 0-2 is not registered when even its slowest depth layer is predicted to move more than
+// this fraction of N along an axis: the circular correlation folds shifts beyond N/2 to the
+// other side, and near it a peak cannot be told from its fold (pair 0-2 of a flight at 60 %
+// overlap moves 0.7 N).
+constexpr double kMaxPairShiftFraction = 0.45;
+
+// The middle value (the upper middle of an even count).
+double medianOf(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Whether a pair's rotation and zoom lie within the prediction's window (true without one).
+bool withinWindow(const PairMotion& motion, const std::optional<RegistrationPrior>& prior) {
+  return !prior || (std::fabs(wrapToPi(motion.rotation - prior->rotation)) <= prior->rotation_window &&
+                    std::fabs(motion.log_zoom - prior->log_zoom) <= prior->log_zoom_window);
+}
+
+struct WindowFrame {
+  FrameSpectra spectra;
+  std::size_t index = 0;
+  double stamp = 0.0;
+};
+
+}  // namespace
+
+const char* toString(TrackingState state) {
+  switch (state) {
+    case TrackingState::kStarted: return "started";
+    case TrackingState::kTracking: return "tracking";
+    case TrackingState::kPredicted: return "predicted";
+    case TrackingState::kHeld: return "held";
+    case TrackingState::kRestarted: return "restarted";
+  }
+  return "unknown";
+}
+
+// The window, the previous pair and the per-size machinery; one method per stage of a frame.
+struct Estimator::State {
+  State(const EstimatorConfig& c, std::shared_ptr<const SpectralContext> context)
+      : config(c),
+        registrar(std::move(context)),
+        registrar02(registrar.sharedContext()),
+        optimizer(c.optimizer),
+        integrator(c.initialAltitude(), c.effectiveFx()),
+        multi_zoom(registrar.sharedContext(), c.efmt) {
+    // A pair 0-2 that does not register only costs this frame its loop: the further rotation/zoom
+    // candidates (up to 4 more registrations, on the tail latency) are kept for pair 1-2.
+    registrar02.setRotationZoomCandidates(1);
+  }
+
+  void clear() {
+    f0.reset();
+    f1.reset();
+    forgetPair01();
+    failed = 0;
+    anchor.reset();
+    last_step.reset();
+    recent_steps.clear();
+    recent_rates.clear();
+    implausible_steps = 0;
+    unconfirmed_steps = 0;
+    started = false;
+    last_stamp = -std::numeric_limits<double>::infinity();
+  }
+  void forgetPair01() {
+    have01 = false;
+    translation01.clear();
+    zoom01.clear();
+  }
+
+  // No anchor frame yet: the frame becomes it (the origin for the very first one).
+  void anchorFrame(WindowFrame&& frame, bool textured, Estimate& est);
+  // The frame could not be registered: predict or hold the pose, maybe restart the window.
+  void registrationFailed(WindowFrame&& frame, bool textured, Estimate& est);
+  // Multi-zoom step of the efmt mode; its fused profile goes to next_translation01.
+  PairMotion efmtStep(const WindowFrame& frame, Estimate& est,
+                      std::vector<float>& next_translation01);
+  // Three-frame step of the oefmt mode: pair 0-2, pattern matching, optimizer.
+  PairMotion oefmtStep(const WindowFrame& frame, Estimate& est, bool with02);
+  // Integrates the step and slides the window.
+  void advance(WindowFrame&& frame, const PairMotion& step, std::vector<float>&& next_translation01,
+               Estimate& est);
+  cv::Matx44d heldGrowth() const;
+  // The step against the motion so far: one the vehicle could not have made (further from the
+  // prediction than the acceleration window) is replaced by the prediction, with a covariance
+  // that covers the difference, and marked degraded; after tracking.max_failed_frames such steps
+  // in a row the measurements are believed and the motion model starts over.
+  PairMotion plausibleStep(const PairMotion& step, Estimate& est);
+  // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
+  // registered: even its slowest layer (of those pair 0-1 saw) must stay within
+  // kMaxPairShiftFraction of N along both axes.
+  bool shiftInReach(const cv::Point2d& followed) const;
+  // The frame failed and the next one could not be registered against frame 1: the window
+  // moves on to it, with the predicted step as its motion.
+  void slideTo(WindowFrame&& frame, const PairMotion& predicted);
+  // The rotation, zoom and translation that the motion so far predicts for a pair spanning
+  // `intervals` frame intervals and `seconds` after frame 1, starting from `start` (pair 0-1
+  // for pair 0-2); none without a motion or outside oefmt mode.
+  std::optional<RegistrationPrior> predictedPair(int intervals, double seconds, const PairMotion* start) const;
+
+  const EstimatorConfig& config;
+  Registrar registrar;
+  Registrar registrar02;  // pair 0-2, on its own thread: its own scratch, the shared tables
+  std::future<PairRegistration> pending02;  // pair 0-2 started alongside pair 1-2
+  std::optional<RegistrationPrior> prior02;  // its predicted rotation/zoom (read by the worker)
+  std::optional<RegistrationPrior> prior12;  // pair 1-2's
+  LocalOptimizer optimizer;
+  PoseIntegrator integrator;
+  MultiZoomTranslator multi_zoom;
+
+  std::optional<WindowFrame> f0, f1;  // frames "0" and "1" of the window
+  // Pair 0-1 (the previous step): integrated motion, energy vectors, raw zoom.
+  bool have01 = false;
+  PairMotion motion01;
+  std::vector<float> translation01;  // T01 (efmt: the fused multi-zoom profile)
+  std::vector<float> zoom01;         // S01
+  double raw_log_zoom01 = 0.0;
+  double raw_log_zoom_sigma01 = 0.0;
+  int gap01 = 1;
+
+  int failed = 0;                       // consecutive frames that could not be registered
+  std::optional<Pose4> anchor;          // the pose at frame 1 while later frames fail
+  std::optional<PairMotion> last_step;  // the last motion per frame interval
+  // The last accepted motions per frame interval, newest last (kept through restarts: the
+  // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
+  std::deque<PairMotion> recent_steps;
+  std::deque<PairMotion> recent_rates;  // of those, the steps whose rotation/zoom were measured
+  int implausible_steps = 0;  // steps in a row replaced by the prediction (plausibleStep)
+  int unconfirmed_steps = 0;  // steps in a row that did not enter recent_steps
+  bool started = false;
+  double last_stamp = -std::numeric_limits<double>::infinity();
+
+  // Runs pair 0-2. Last: destroyed (its task finished) before the frames and the registrar
+  // that task reads.
+  detail::WorkerThread worker02;
+};
+
+// While pair 0-2 runs on the worker it reads the newest frame, a local of Estimator::push: an
+// exception that leaves push early must first wait for it.
+class PendingPairGuard {
+ public:
+  explicit PendingPairGuard(std::future<PairRegistration>& pending)
+      : pending_(pending), exceptions_(std::uncaught_exceptions()) {}
+  ~PendingPairGuard() {
+    if (std::uncaught_exceptions() > exceptions_ && pending_.valid()) {
+      pending_.wait();
+      pending_ = {};
+    }
+  }
+  PendingPairGuard(const PendingPairGuard&) = delete;
+  PendingPairGuard& operator=(const PendingPairGuard&) = delete;
+
+ private:
+  std::future<PairRegistration>& pending_;
+  int exceptions_;
+};
+
+std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, double seconds,
+                                                                const PairMotion* start) const {
+  if (config.mode != EstimatorMode::kOefmt || recent_steps.empty()) return std::nullopt;
+  const int n = config.registration.size;
+  // The turns and zooms come from the steps that measured them (a step on the predicted rotation
+  // and zoom would only repeat the prediction), the translations from all the last steps.
+  const std::deque<PairMotion>& rates = recent_rates.empty() ? recent_steps : recent_rates;
+  // The median of the last steps' values: one wrong step does not move the prediction.
+  const auto medianOfSteps = [](const std::deque<PairMotion>& steps, auto field) {
+    std::vector<double> values;
+    for (const PairMotion& m : steps) values.push_back(field(m));
+    return medianOf(std::move(values));
+  };
+  const auto rate = [&](auto field) { return medianOfSteps(rates, field); };
+  const auto median = [&](auto field) { return medianOfSteps(recent_steps, field); };
+  RegistrationPrior prior;
+  prior.rotation = rate([](const PairMotion& m) { return m.rotation; }) * intervals;
+  prior.log_zoom = rate([](const PairMotion& m) { return m.log_zoom; }) * intervals;
+  double rotation_sigma = rate([](const PairMotion& m) { return m.rotation_sigma; }) * intervals;
+  double log_zoom_sigma = rate([](const PairMotion& m) { return m.log_zoom_sigma; }) * intervals;
+  const double rotation12 = prior.rotation, log_zoom12 = prior.log_zoom;
+  // The window's fixed part in rotation and ln zoom, and a third of it: a frame interval's
+  // possible change of the rates.
+  const double rotation_bins = kPriorWindowBins * CV_PI / n;
+  const double log_zoom_bins = kPriorWindowBins * registrar.logZoomPerBin();
+  // How far the last steps strayed from the median, plus a frame interval's change of the rates.
+  double rotation_spread = 0.0, log_zoom_spread = 0.0;
+  for (const PairMotion& m : rates) {
+    rotation_spread = std::max(rotation_spread, std::fabs(m.rotation * intervals - rotation12));
+    log_zoom_spread = std::max(log_zoom_spread, std::fabs(m.log_zoom * intervals - log_zoom12));
+  }
+  prior.rotation_spread = std::hypot(rotation_spread, rotation_bins / 3.0);
+  prior.log_zoom_spread = std::hypot(log_zoom_spread, log_zoom_bins / 3.0);
+  if (start != nullptr) {
+    prior.rotation += start->rotation;
+    prior.log_zoom += start->log_zoom;
+    rotation_sigma = std::hypot(rotation_sigma, start->rotation_sigma);
+    log_zoom_sigma = std::hypot(log_zoom_sigma, start->log_zoom_sigma);
+  }
+  prior.rotation_window = rotation_bins + 3.0 * rotation_sigma;
+  prior.log_zoom_window = log_zoom_bins + 3.0 * log_zoom_sigma;
+  // A registration on the prediction itself measured neither: the prediction's own sigma plus a
+  // frame interval's change of the rates.
+  prior.rotation_sigma = std::hypot(rotation_sigma, rotation_bins / 3.0);
+  prior.log_zoom_sigma = std::hypot(log_zoom_sigma, log_zoom_bins / 3.0);
+  if (last_step && seconds > 0.0) {
+    // The translation per interval in the camera's axes: the median length of the last steps,
+    // and the last direction turned on by the median turn between steps (steady in a
+    // coordinated turn, turning steadily when the heading is held on a curve).
+    const double length = median([](const PairMotion& m) { return m.shift(); });
+    double direction = recent_steps.back().direction();
+    double turn_spread = 0.0;
+    if (recent_steps.size() >= 2) {
+      std::vector<double> turns;
+      for (std::size_t k = 1; k < recent_steps.size(); ++k) {
+        turns.push_back(wrapToPi(recent_steps[k].direction() - recent_steps[k - 1].direction()));
+      }
+      const double turn = medianOf(turns);
+      direction += turn;
+      for (const double t : turns) turn_spread = std::max(turn_spread, std::fabs(t - turn));
+    }
+    const cv::Point2d per_interval = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
+    // How far the last steps strayed from it: along (their lengths) and across (their turns).
+    double spread = 0.0;
+    for (const PairMotion& m : recent_steps) spread = std::max(spread, std::fabs(m.shift() - length));
+    spread = std::hypot(spread, turn_spread * length);
+    prior.translation = per_interval * intervals;
+    double uncertainty = spread * intervals;
+    prior.translation_sigma = uncertainty;
+    if (start != nullptr) {
+      // d02 = s12 R(theta12) d01 + d12.
+      prior.translation += rotateImageVector(start->translation, rotation12) * std::exp(log_zoom12);
+      uncertainty += std::sqrt(std::max(cv::trace(start->translation_covariance), 0.0));
+    }
+    const double metres = config.altitude > 0.0 ? integrator.altitude()
+                                                : config.tracking.assumed_altitude * integrator.altitude();
+    prior.translation_radius = config.effectiveFx() * config.tracking.max_acceleration * seconds * seconds /
+                                   std::max(metres, 1e-6) +
+                               3.0 * uncertainty + kTranslationWindowFloor;
+  }
+  return prior;
+}
+
+bool Estimator::State::shiftInReach(const cv::Point2d& followed) const {
+  // The slowest layer pair 0-1 saw (the farthest plane) moves the least.
+  double fraction = 1.0;
+  const double length01 = motion01.shift();
+  if (have01 && length01 > 0.0) {
+    for (const EnergyPeak& peak : energyPeaks(translation01, config.tracking.layer_min_fraction)) {
+      fraction = std::min(fraction, peak.bin * registrar.shiftPerBin() / length01);
+    }
+  }
+  const double limit = kMaxPairShiftFraction * config.registration.size;
+  return std::fabs(followed.x * fraction) <= limit && std::fabs(followed.y * fraction) <= limit;
+}
+
+cv::Matx44d Estimator::State::heldGrowth() const {
+  const double altitude = integrator.altitude();
+  const double xy = kHeldPositionSigma * altitude, z = kHeldAltitudeSigma * altitude;
+  return cv::Matx44d::diag(cv::Vec4d(xy * xy, xy * xy, z * z, kHeldYawSigma * kHeldYawSigma));
+}
+
+void Estimator::State::anchorFrame(WindowFrame&& frame, bool textured, Estimate& est) {
+  if (!started) {
+    integrator.reset(frame.stamp);
+    started = true;
+    est.state = TrackingState::kStarted;
+  } else {
+    integrator.hold(frame.stamp, heldGrowth());
+    est.state = TrackingState::kHeld;
+  }
+  if (textured) {
+    f1 = std::move(frame);
+  } else {
+    est.degraded = true;
+  }
+}
+
+void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Estimate& est) {
+  ++failed;
+  est.degraded = true;
+  if (!anchor) anchor = integrator.pose();
+  if (config.tracking.predict_failed_frames && last_step && failed <= config.tracking.max_failed_frames) {
+    PairMotion predicted = *last_step;
+    const double spread = config.tracking.prediction_sigma * predicted.shift();
+    predicted.translation_covariance += cv::Matx22d::eye() * (spread * spread + 1.0);
+    predicted.rotation_sigma = std::hypot(predicted.rotation_sigma, kPredictedRotationSigma);
+    predicted.log_zoom_sigma = std::hypot(predicted.log_zoom_sigma, kPredictedLogZoomSigma);
+    integrator.integrate(predicted, frame.stamp);
+    est.state = TrackingState::kPredicted;
+    // The next frame would be registered against frame 1 over one more interval: at low overlap
+    // that pair is out of reach, and every later frame would fail too.
+    if (textured && f1 &&
+        !shiftInReach(last_step->translation * (static_cast<double>(frame.index - f1->index) + 1.0))) {
+      slideTo(std::move(frame), predicted);
+      return;
+    }
+  } else {
+    integrator.hold(frame.stamp, heldGrowth());
+    est.state = TrackingState::kHeld;
+  }
+  if (failed <= config.tracking.max_failed_frames) return;
+  // Too long without a registration: restart from this frame, continuing from this pose.
+  f0.reset();
+  forgetPair01();
+  anchor.reset();
+  last_step.reset();
+  // Nothing of the motion before carries over: the next registrations search everywhere.
+  recent_steps.clear();
+  implausible_steps = 0;
+  failed = 0;
+  if (textured) {
+    f1 = std::move(frame);
+    est.state = TrackingState::kRestarted;
+  } else {
+    f1.reset();
+  }
+}
+
+PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est) {
+  if (!prior12 || !(prior12->translation_radius > 0.0)) return step;
+  const cv::Point2d off = step.translation - prior12->translation;
+  if (cv::norm(off) <= prior12->translation_radius) {
+    implausible_steps = 0;
+    return step;
+  }
+  if (++implausible_steps > config.tracking.max_failed_frames) {
+    // The measurements have disagreed with the model for longer than frames may fail: the
+    // vehicle did change its motion. Believe them from here.
+    implausible_steps = 0;
+    recent_steps.clear();
+    recent_rates.clear();
+    return step;
+  }
+  est.degraded = true;
+  est.step_implausible = true;
+  PairMotion predicted = step;
+  predicted.translation = prior12->translation;
+  const double spread = cv::norm(off);
+  predicted.translation_covariance = step.translation_covariance + cv::Matx22d::eye() * (spread * spread);
+  return predicted;
+}
+
+void Estimator::State::slideTo(WindowFrame&& frame, const PairMotion& predicted) {
+  // Pair 0-1's energy vectors stay the scale reference (its speed is the one predicted).
+  anchor.reset();
+  motion01 = predicted;
+  gap01 = 1;
+  f0 = std::move(f1);
+  f1 = std::move(frame);
+}
+
+PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
+                                      std::vector<float>& next_translation01) {
+  PairMotion step = est.measured12;
+  Clock::time_point t = Clock::now();
+  MultiZoomTranslation mz = multi_zoom.analyse(f1->spectra, frame.spectra, est.registration12);
+  est.registration_ms += msSince(t);
+  if (!mz.valid) return step;
+  const double shift_per_bin = registrar.shiftPerBin();
+  // The unit length (first pair) is the dominant correlation peak's, as in oefmt's start-up;
+  // later lengths follow it by PMT (or fall back to the fused profile's peak).
+  double length = have01 ? refinedArgmax(mz.profile) * shift_per_bin : step.shift();
+  double length_sigma = alongTrackSigma(step);
+  if (have01 && !translation01.empty() &&
+      motion01.shift() >= config.matching.min_peak_bins * shift_per_bin) {
+    t = Clock::now();
+    est.pmt12 = matchStretch(translation01, mz.profile,
+                             detail::stretchOptions(config.matching, double(est.frame_gap) / gap01,
+                                                    config.matching.stretch_key_12,
+                                                    motion01.shift() / shift_per_bin));
+    est.matching_ms = msSince(t);
+    if (est.pmt12.valid) {
+      length = est.pmt12.value * motion01.shift();
+      length_sigma = std::hypot(length * est.pmt12.sigma, est.pmt12.value * alongTrackSigma(motion01));
+    }
+  }
+  step.translation = cv::Point2d(std::cos(mz.direction), std::sin(mz.direction)) * length;
+  step.translation_covariance = alongAcrossCovariance(
+      mz.direction, std::max(length_sigma, kMinShiftSigma),
+      std::max(length * mz.direction_sigma * config.uncertainty.direction_scale, kMinShiftSigma));
+  next_translation01 = std::move(mz.profile);
+  return step;
+}
+
+PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, bool with02) {
+  Clock::time_point t = Clock::now();
+  if (with02) {
+    est.registration02 = pending02.valid()
+                             ? pending02.get()
+                             : registrar02.registerPair(f0->spectra, frame.spectra,
+                                                        RegistrationMethod::kEnergyVectors, nullptr,
+                                                        prior02 ? &*prior02 : nullptr);
+    est.has_registration02 = true;
+  }
+  est.registration_ms += msSince(t);
+  const PairRegistration& reg12 = est.registration12;
+  const PairRegistration& reg02 = est.registration02;
+  const bool usable02 = with02 && reg02.usable();
+  const double shift_per_bin = registrar.shiftPerBin();
+  const double log_zoom_per_bin = registrar.logZoomPerBin();
+  const int gap12 = est.frame_gap;
+  const int gap02 = gap01 + gap12;
+  detail::Reference ref;
+  ref.translation = motion01.translation;
+  ref.shift = motion01.shift();
+  ref.shift_sigma = alongTrackSigma(motion01);
+  ref.raw_log_zoom = raw_log_zoom01;
+  ref.raw_log_zoom_sigma = raw_log_zoom_sigma01;
+  ref.translation_energy = &translation01;
+
+  // Pattern matching against pair 0-1's energy vectors: stretches ~ gap ratios, shifts ~ 0.
+  const MatchingConfig& mc = config.matching;
+  t = Clock::now();
+  if (!translation01.empty() && ref.shift >= mc.min_peak_bins * shift_per_bin) {
+    const double reference_bin = ref.shift / shift_per_bin;
+    est.pmt12 = matchStretch(translation01, reg12.translation_energy,
+                             detail::stretchOptions(mc, double(gap12) / gap01, mc.stretch_key_12,
+                                                    reference_bin));
+    if (usable02) {
+      est.pmt02 = matchStretch(translation01, reg02.translation_energy,
+                               detail::stretchOptions(mc, double(gap02) / gap01, mc.stretch_key_02,
+                                                      reference_bin));
+    }
+  }
+  if (!zoom01.empty()) {
+    est.pms12 = matchShift(zoom01, reg12.zoom_energy, detail::shiftOptions(mc));
+    if (usable02) est.pms02 = matchShift(zoom01, reg02.zoom_energy, detail::shiftOptions(mc));
+    // A shift puts the pair's zoom at S01's plus the shift; outside the window the motion so
+    // far predicts for the pair, it matched another feature of the vectors.
+    const auto implausible = [&](const MatchResult& pms, const std::optional<RegistrationPrior>& prior) {
+      const double log_zoom = raw_log_zoom01 - pms.value * log_zoom_per_bin;
+      return prior && std::fabs(log_zoom - prior->log_zoom) > prior->log_zoom_window;
+    };
+    if (est.pms12.valid && implausible(est.pms12, prior12)) est.pms12.valid = false;
+    if (est.pms02.valid && implausible(est.pms02, prior02)) est.pms02.valid = false;
+  }
+  est.matching_ms = msSince(t);
+
+  PairMotion initial12;
+  const PairObservations obs12 =
+      detail::observe(reg12, est.measured12, est.pmt12, est.pms12, ref, config, shift_per_bin,
+                      log_zoom_per_bin, double(gap12) / gap01, prior12 ? &*prior12 : nullptr, initial12);
+  est.translation_use12 = obs12.translation_use;
+  est.measured12 = initial12;
+  // With a predicted translation the observations already follow the layer (observe()).
+  const bool predicted_translation = prior12 && prior12->translation_radius > 0.0;
+  const auto followLayer = [&](const PairMotion& candidate) {
+    return predicted_translation ? candidate
+                                 : detail::steadyLayerStep(candidate, reg12, translation01,
+                                                           ref.shift * gap12 / gap01, config,
+                                                           shift_per_bin, double(gap12) / gap01);
+  };
+  if (!usable02) return followLayer(initial12);  // no loop: the gated measurement
+
+  PairMotion initial02;
+  const PairObservations obs02 = detail::observe(
+      reg02, detail::calibrated(reg02, config.uncertainty), est.pmt02, est.pms02, ref, config,
+      shift_per_bin, log_zoom_per_bin, double(gap02) / gap01, prior02 ? &*prior02 : nullptr, initial02);
+  est.translation_use02 = obs02.translation_use;
+  t = Clock::now();
+  est.loop = optimizer.solve(motion01, obs12, obs02, initial12, initial02);
+  est.optimizer_ms = msSince(t);
+  if (est.loop.status == OptimizerStatus::kConverged && !withinWindow(est.loop.pair12, prior12)) {
+    // The loop bought its closure with a rotation or zoom the motion so far rules out (an outlier
+    // elsewhere in the loop pulled a loosely measured value): the measurement stands.
+    est.loop.status = OptimizerStatus::kFallback;
+    est.loop.message = "rotation or zoom outside the predicted window";
+  }
+  if (est.loop.status != OptimizerStatus::kConverged) {
+    est.degraded = true;
+    return initial12;
+  }
+  if (ref.shift > 0.0) est.lambda_t02 = est.loop.pair02.shift() / ref.shift;
+  return followLayer(est.loop.pair12);
+}
+
+void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
+                               std::vector<float>&& next_translation01, Estimate& est) {
+  // Integrate, from the anchor if predictions were made while frames failed.
+  if (anchor) integrator.restore(*anchor);
+  integrator.integrate(step, frame.stamp);
+  est.step = step;
+  est.state = TrackingState::kTracking;
+  if (have01 && motion01.shift() > 0.0) est.lambda_t12 = step.shift() / motion01.shift();
+
+  // Slide the window: the integrated 1-2 becomes the next 0-1.
+  last_step = detail::perInterval(step, est.frame_gap);
+  // A prediction standing in for a step (or for its direction) says nothing new. When the
+  // measurements keep disagreeing with the prediction for longer than frames may fail, the motion
+  // changed: the model starts over from the measurements.
+  if (!est.step_implausible && est.translation_use12 != PairObservations::TranslationUse::kNone) {
+    recent_steps.push_back(*last_step);
+    if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
+    if (est.registration12.rotation_zoom_candidate != PairRegistration::kPredicted) {
+      recent_rates.push_back(*last_step);
+      if (recent_rates.size() > kPredictionSteps) recent_rates.pop_front();
+    }
+    unconfirmed_steps = 0;
+  } else if (++unconfirmed_steps > config.tracking.max_failed_frames) {
+    recent_steps.clear();
+    recent_rates.clear();
+    unconfirmed_steps = 0;
+  }
+  motion01 = step;
+  translation01 = std::move(next_translation01);
+  zoom01 = est.registration12.zoom_energy;
+  raw_log_zoom01 = est.measured12.log_zoom;
+  raw_log_zoom_sigma01 = est.measured12.log_zoom_sigma;
+  gap01 = est.frame_gap;
+  have01 = true;
+  failed = 0;
+  anchor.reset();
+  f0 = std::move(f1);
+  f1 = std::move(frame);
+}
+
+Estimator::Estimator(const EstimatorConfig& config) : config_(config) {
+  config_.validate();
+  state_ = std::make_unique<State>(config_, std::make_shared<const SpectralContext>(config_.registration));
+}
+
+Estimator::Estimator(const EstimatorConfig& config, std::shared_ptr<const SpectralContext> context)
+    : config_(config) {
+  config_.validate();
+  if (!context || context->config() != config_.registration) {
+    throw InputError("Estimator: the spectral context was made for other registration parameters");
+  }
+  state_ = std::make_unique<State>(config_, std::move(context));
+}
+
+std::shared_ptr<const SpectralContext> Estimator::spectralContext() const {
+  return state_->registrar.sharedContext();
+}
+
+Estimator::~Estimator() = default;
+
+void Estimator::reset() {
+  state_->clear();
+  frame_count_ = 0;
+}
+
+const Pose4& Estimator::pose() const { return state_->integrator.pose(); }
+double Estimator::shiftPerBin() const { return state_->registrar.shiftPerBin(); }
+double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
+
+bool Estimator::acceptsStamp(double stamp) const {
+  return std::isfinite(stamp) && stamp >= state_->last_stamp;
+}
+
+std::optional<Estimate> Estimator::push(const cv::Mat& image, double stamp, ChannelOrder order) {
+  if (!acceptsStamp(stamp)) return std::nullopt;
+  const Clock::time_point start = Clock::now();
+  FrameSpectra spectra = state_->registrar.analyse(image, order);
+  return process(std::move(spectra), stamp, msSince(start));
+}
+
+std::optional<Estimate> Estimator::push(const PreparedImage& image, double stamp) {
+  if (!acceptsStamp(stamp)) return std::nullopt;
+  const Clock::time_point start = Clock::now();
+  FrameSpectra spectra = state_->registrar.analyse(image);
+  return process(std::move(spectra), stamp, msSince(start));
+}
+
+std::optional<Estimate> Estimator::push(FrameSpectra spectra, double stamp) {
+  const int n = config_.registration.size;
+  if (spectra.empty() || spectra.grey.rows != n || spectra.grey.cols != n ||
+      spectra.spectrum.rows != n || spectra.log_polar_spectrum.rows != n) {
+    throw InputError("Estimator: the frame's spectra are empty or not of size " + std::to_string(n));
+  }
+  if (!acceptsStamp(stamp)) return std::nullopt;
+  return process(std::move(spectra), stamp, 0.0);
+}
+
+std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, double prepare_ms) {
+  const Clock::time_point start = Clock::now();
+  State& s = *state_;
+  Estimate est;
+  est.frame_index = frame_count_++;
+  est.stamp = stamp;
+  est.mode = config_.mode;
+  est.registration_ms = prepare_ms;
+  s.last_stamp = stamp;
+  const bool textured = std::isfinite(spectra.texture) &&
+                        spectra.texture >= config_.registration.min_texture;
+  WindowFrame frame{std::move(spectra), est.frame_index, stamp};
+
+  if (!s.f1) {
+    s.anchorFrame(std::move(frame), textured, est);
+  } else {
+    est.frame_gap = static_cast<int>(frame.index - s.f1->index);
+    const RegistrationMethod method = config_.mode == EstimatorMode::kFmt
+                                          ? RegistrationMethod::kClassic
+                                          : RegistrationMethod::kEnergyVectors;
+    const Clock::time_point t = Clock::now();
+    const double seconds12 = frame.stamp - s.f1->stamp;
+    const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
+                        s.shiftInReach(s.motion01.translation * (double(s.gap01 + est.frame_gap) / s.gap01));
+    s.prior02 = with02 ? s.predictedPair(est.frame_gap, seconds12, &s.motion01) : std::nullopt;
+    if (with02 && config_.parallel_registrations) {
+      // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
+      // cached spectra; each Registrar has its own scratch). Collected in oefmtStep; discarded
+      // if pair 1-2 fails.
+      const FrameSpectra& older = s.f0->spectra;
+      const FrameSpectra& newer = frame.spectra;
+      s.pending02 = s.worker02.submit([&s, &older, &newer] {
+        return s.registrar02.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr,
+                                          s.prior02 ? &*s.prior02 : nullptr);
+      });
+    }
+    const PendingPairGuard pending_guard(s.pending02);
+    RegistrationSurfaces* surfaces = nullptr;
+    if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
+    s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
+    est.prediction12 = s.prior12;
+    est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
+                                                  s.prior12 ? &*s.prior12 : nullptr);
+    est.registration_ms += msSince(t);
+    if (!est.registration12.usable()) {
+      if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below
+      s.pending02 = {};
+      s.registrationFailed(std::move(frame), textured, est);
+    } else {
+      est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
+      std::vector<float> next_translation01 = est.registration12.translation_energy;
+      PairMotion step = est.measured12;
+      if (config_.mode == EstimatorMode::kEfmt) {
+        step = s.efmtStep(frame, est, next_translation01);
+      } else if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01) {
+        step = s.oefmtStep(frame, est, with02);
+      }
+      if (config_.mode == EstimatorMode::kOefmt) step = s.plausibleStep(step, est);
+      s.advance(std::move(frame), step, std::move(next_translation01), est);
+    }
+  }
+  est.pose = s.integrator.pose();
+  if (est.state != TrackingState::kStarted) est.step_covariance = s.integrator.lastStepCovariance();
+  est.total_ms = prepare_ms + msSince(start);
+  est.estimator_ms = std::max(0.0, est.total_ms - est.registration_ms);
+  return std::optional<Estimate>(std::move(est));
+}
+
+}  // namespace oefmt

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Internal to the estimator: registrations and pattern matches turned into calibrated motions and
+// optimizer observations.
+#pragma once
+
+#include "oefmt/estimation/estimator_config.h"
+#include "oefmt/estimation/local_optimizer.h"
+#include "oefmt/estimation/pair_motion.h"
+#include "oefmt/registration/pattern_matching.h"
+#include "oefmt/registration/registration.h"
+
+namespace oefmt {
+namespace detail {
+
+/// Smallest sigma of a shift handed on [px], so that no weight becomes infinite.
+constexpr double kMinShiftSigma = 0.01;
+
+/// A registration as a PairMotion, its peak widths turned into error sigmas (UncertaintyConfig);
+/// non-finite values become "no motion" with wide sigmas.
+PairMotion calibrated(const PairRegistration& registration, const UncertaintyConfig& uncertainty);
+
+/// 1-sigma of |d| (along d) of a motion's translation.
+double alongTrackSigma(const PairMotion& motion);
+
+/// The motion of one frame interval from a motion spanning `gap` intervals.
+PairMotion perInterval(const PairMotion& motion, int gap);
+
+/// PMT options; the no-motion bins are skipped when the reference peak lies well beyond them.
+StretchMatchOptions stretchOptions(const MatchingConfig& matching, double init, double key,
+                                   double reference_bin);
+ShiftMatchOptions shiftOptions(const MatchingConfig& matching);
+
+/// What a pair's observations are related to: pair 0-1 of the window.
+struct Reference {
+  cv::Point2d translation;          ///< d01 [px of frame 1]
+  double shift = 0.0;               ///< |d01|
+  double shift_sigma = 0.0;         ///< its 1-sigma
+  double raw_log_zoom = 0.0;        ///< ln s of the registration that produced S01
+  double raw_log_zoom_sigma = 0.0;
+  const std::vector<float>* translation_energy = nullptr;  ///< T01 (may be empty)
+};
+
+/// The optimizer observations of one pair (1-2 or 0-2) spanning `intervals` times pair 0-1's
+/// frame intervals, and its starting value `initial`:
+/// - the registration (rotation, zoom, d) and, if valid, the PMS zoom relative to S01;
+/// - the PMT length prediction lambda |d01|; a correlation peak whose length is off the
+///   prediction by more than tracking.layer_gate belongs to another depth layer (or is an alias):
+///   only its direction is kept and the translation energy peak nearest to the prediction (the
+///   followed layer) gives the length;
+/// - a weak prior that the pair continues pair 0-1's motion (tracking.motion_prior_sigma).
+///
+/// With a predicted translation (`prior`, from the motion so far), the prediction decides which
+/// peak is the followed layer's instead of the PMT: the correlation peak when it lies within
+/// tracking.layer_gate of the prediction, else the peak the prediction points at
+/// (PairRegistration::followed_translation) when it stands out; else the followed layer is not
+/// in view: the layers of steadyLayerStep (the followed layer's trace in the energy vector, or a
+/// layer seen in both pairs) give its length and the correlation peak its direction if that
+/// lies on the predicted one (another layer of the same motion; otherwise nothing of it: a
+/// repetitive texture's alias); where no layer tells, a correlation peak within the
+/// acceleration window stands (the motion changed), else the prediction's length.
+PairObservations observe(const PairRegistration& registration, const PairMotion& measured,
+                         const MatchResult& pmt, const MatchResult& pms, const Reference& reference,
+                         const EstimatorConfig& config, double shift_per_bin,
+                         double log_zoom_per_bin, double intervals, const RegistrationPrior* prior,
+                         PairMotion& initial);
+
+/// The step of pair 1-2 that keeps following one depth layer. `candidate` is the loop's step
+/// (without a loop, the gated measurement). When its length is off steady speed (pair 0-1's
+/// shift continued over `intervals`) by more than tracking.layer_gate:
+/// - a peak of pair 1-2's translation energy vector within layer_gate of the steady length (the
+///   followed layer) gives the length;
+/// - without one (the layer has left the view), the layers seen in both pairs at steady speed
+///   (a peak of pair 1-2 and one of pair 0-1's `translation01` within layer_gate of each other
+///   over the intervals) give the speed ratio, the one nearest to steady wins, and the step is
+///   the steady length times it: the followed layer's scale is kept.
+/// Pair 1-2's peaks must reach tracking.steady_layer_min_fraction of its maximum, pair 0-1's
+/// tracking.layer_min_fraction. A hop to another layer's peak (the dominant peak's, or a stretch
+/// matched to the wrong layer, in one pair or in both pairs of the loop alike) is far likelier
+/// than a speed change by a layer ratio within one frame interval; a real speed change leaves no
+/// layer at steady speed and stands (one by exactly the ratio of two layers' depths cannot be
+/// told from a hop). Slow motion (a steady length within 4 x matching.skip_bins, where a static
+/// pattern's no-motion peak lies) is left alone too.
+/// `steady` is the followed layer's expected length [px] (pair 0-1's continued).
+PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
+                           const std::vector<float>& translation01, double steady,
+                           const EstimatorConfig& config, double shift_per_bin, double intervals);
+
+}  // namespace detail
+}  // namespace oefmt

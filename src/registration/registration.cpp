@@ -1,0 +1,485 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/registration/registration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "oefmt/registration/energy_vector.h"
+#include "oefmt/error.h"
+#include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/warp.h"
+
+namespace oefmt {
+namespace {
+
+// Peak-to-sidelobe ratios mapped to a 0..1 confidence. The translation surface decides: after
+// the warp it only peaks when rotation and zoom were right too; unrelated textures give about
+// 15 at N = 512, clean registrations hundreds. The rotation/zoom surface weakens long before
+// the registration fails (large shifts change the magnitude spectrum), so it has lower bounds.
+constexpr double kTranslationPsrFloor = 20.0;
+constexpr double kTranslationPsrGood = 60.0;
+constexpr double kRotationZoomPsrFloor = 6.0;
+constexpr double kRotationZoomPsrGood = 20.0;
+
+// Rows of the polar unwrap (and of the rotation/zoom surface) that compete for the energy row:
+// rows further than 10 from the peak are overruled by the peak row anyway (spec 2.4 step 4b).
+constexpr int kPolarBandHalfWidth = 16;
+constexpr int kEnergyRowBand = 12;
+
+// Half size of the window cleared around a rotation/zoom peak already tried [bins]: wider than
+// the log-polar peak, narrower than a quarter turn's distance.
+constexpr int kTriedPeakRadius = 6;
+
+// A second peak of the window whose weighted height reaches this share of the first's competes
+// with it (both are registered).
+constexpr double kCompetingPeak = 0.5;
+
+// Zeroes the (2 radius + 1)^2 window around p, rows and columns cyclic (both wrap on the
+// rotation/zoom surface).
+void clearAround(cv::Mat1f& surface, const cv::Point& p, int radius) {
+  for (int dr = -radius; dr <= radius; ++dr) {
+    float* row = surface[((p.y + dr) % surface.rows + surface.rows) % surface.rows];
+    for (int dc = -radius; dc <= radius; ++dc) row[((p.x + dc) % surface.cols + surface.cols) % surface.cols] = 0.0f;
+  }
+}
+
+double wrapAngle(double a) {
+  a = std::fmod(a + CV_PI, 2.0 * CV_PI);
+  if (a <= 0.0) a += 2.0 * CV_PI;
+  return a - CV_PI;
+}
+
+// Gaussian widths (rows, columns) of the |.|^3 peak, for the single-peak (classic) method.
+cv::Point2d peakWidths(const cv::Mat1f& surface, const SurfacePeak& peak, bool cyclic_cols) {
+  constexpr int kRadius = 2;
+  float along_rows[2 * kRadius + 1];
+  float along_cols[2 * kRadius + 1];
+  for (int o = -kRadius; o <= kRadius; ++o) {
+    const int r = ((peak.row + o) % surface.rows + surface.rows) % surface.rows;
+    int c = peak.col + o;
+    float col_value = 0.0f;
+    if (cyclic_cols) {
+      col_value = surface(peak.row, (c % surface.cols + surface.cols) % surface.cols);
+    } else if (c >= 0 && c < surface.cols) {
+      col_value = surface(peak.row, c);
+    }
+    along_rows[o + kRadius] = std::pow(std::fabs(surface(r, peak.col)), 3.0f);
+    along_cols[o + kRadius] = std::pow(std::fabs(col_value), 3.0f);
+  }
+  return {gaussianWidth(along_cols, 2 * kRadius + 1, kRadius + peak.sub_col - peak.col, kRadius, false),
+          gaussianWidth(along_rows, 2 * kRadius + 1, kRadius + peak.sub_row - peak.row, kRadius, false)};
+}
+
+// The configured block radius and smoothing; the callers set what differs per surface.
+EnergyVectorOptions energyVectorOptions(const RegistrationConfig& config) {
+  EnergyVectorOptions options;
+  options.block_radius = config.block_radius;
+  options.smoothing_sigma = config.energy_smoothing_sigma;
+  return options;
+}
+
+double confidenceFrom(double psr, double floor, double good) {
+  return std::clamp((psr - floor) / (good - floor), 0.0, 1.0);
+}
+
+}  // namespace
+
+const char* toString(RegistrationStatus status) {
+  switch (status) {
+    case RegistrationStatus::kOk: return "ok";
+    case RegistrationStatus::kLowConfidence: return "low_confidence";
+    case RegistrationStatus::kTextureless: return "textureless";
+  }
+  return "unknown";
+}
+
+Registrar::Registrar(const RegistrationConfig& config)
+    : Registrar(std::make_shared<const SpectralContext>(config)) {}
+
+Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
+    : context_(std::move(context)),
+      builder_(context_),
+      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {}
+
+FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {
+  return builder_.build(image, order);
+}
+
+FrameSpectra Registrar::analyse(const PreparedImage& image) { return builder_.build(image); }
+
+double Registrar::logZoomPerBin() const { return std::log(context_->logPolarBase()); }
+
+PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameSpectra& newer,
+                                         RegistrationMethod method,
+                                         RegistrationSurfaces* surfaces,
+                                         const RegistrationPrior* prior) {
+  const int n = context_->size();
+  if (older.empty() || newer.empty()) throw InputError("registerPair: a frame is empty");
+  if (older.grey.rows != n || newer.grey.rows != n || older.spectrum.size() != newer.spectrum.size()) {
+    throw InputError("registerPair: frames were analysed at a different size than " +
+                     std::to_string(n));
+  }
+  PairRegistration result;
+  const double min_texture = context_->config().min_texture;
+  if (!(older.texture >= min_texture) || !(newer.texture >= min_texture)) {
+    // Nothing to correlate: report the prior (no motion) with uninformative sigmas.
+    result.status = RegistrationStatus::kTextureless;
+    result.rotation_sigma = CV_PI;
+    result.log_zoom_sigma = 1.0;
+    result.direction_sigma = CV_PI;
+    result.shift_sigma = n;
+    return result;
+  }
+  correlateRotationZoom(older, newer);
+  if (prior != nullptr) {
+    result = registerInWindow(older, newer, method, *prior, surfaces);
+  } else {
+    // A lattice of blocks or a repetitive texture can give a wrong rotation/zoom peak (a quarter
+    // turn, a wrong zoom) the highest value; the translation surface then shows no peak. The
+    // next highest peaks are tried until one registers: the surface is computed once, and each
+    // candidate clears the window around the one before.
+    SurfacePeak peak = rotation_zoom_highest_;
+    for (int attempt = 0; attempt < rotation_zoom_candidates_; ++attempt) {
+      if (attempt > 0) {
+        clearAround(rotation_zoom_surface_, cv::Point(peak.col, peak.row), kTriedPeakRadius);
+        peak = findPeak(rotation_zoom_surface_, true, nullptr, PeakShape::kBroadened);
+      }
+      PairRegistration trial;
+      RegistrationSurfaces trial_surfaces;
+      registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, nullptr);
+      if (attempt == 0 || trial.confidence > result.confidence) {
+        result = std::move(trial);
+        result.rotation_zoom_candidate = attempt;
+        if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+      }
+      if (result.status == RegistrationStatus::kOk) break;
+    }
+  }
+  if (prior != nullptr && result.status != RegistrationStatus::kOk) {
+    PairRegistration trial;
+    RegistrationSurfaces trial_surfaces;
+    registerOnPrior(older, newer, method, *prior, trial, surfaces ? &trial_surfaces : nullptr);
+    if (trial.confidence > result.confidence) {
+      result = std::move(trial);
+      if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+    }
+  }
+  return result;
+}
+
+cv::Point2d Registrar::windowCentre(const RegistrationPrior& window) const {
+  // Rows: theta = (row - N/2) pi / N, modulo pi (the half turn is decided later); columns:
+  // ln s = -(col - N/2) ln b.
+  const int n = context_->size();
+  return {n / 2 - window.log_zoom / logZoomPerBin(), n / 2 + window.rotation * n / CV_PI};
+}
+
+SurfacePeak Registrar::windowPeak(const RegistrationPrior& window, cv::Point exclude) const {
+  const int n = context_->size();
+  const double log_zoom_per_bin = logZoomPerBin();
+  const cv::Point2d centre = windowCentre(window);
+  const int half_rows = static_cast<int>(std::ceil(window.rotation_window * n / CV_PI));
+  const int half_cols = static_cast<int>(std::ceil(window.log_zoom_window / log_zoom_per_bin));
+  const cv::Point2d sigma(window.log_zoom_spread / log_zoom_per_bin, window.rotation_spread * n / CV_PI);
+  return findPeakInWindow(rotation_zoom_surface_,
+                          cv::Point(static_cast<int>(std::lround(centre.x)), static_cast<int>(std::lround(centre.y))),
+                          half_rows, half_cols, true, PeakShape::kBroadened, sigma, exclude);
+}
+
+double Registrar::windowWeight(const RegistrationPrior& window, cv::Point peak) const {
+  const int n = context_->size();
+  const cv::Point2d centre = windowCentre(window);
+  const double sigma_cols = window.log_zoom_spread / logZoomPerBin();
+  const double sigma_rows = window.rotation_spread * n / CV_PI;
+  if (!(sigma_cols > 0.0 && sigma_rows > 0.0)) return 1.0;
+  // Rows wrap (the surface spans a half turn), columns too (circular correlation).
+  const double dr = std::remainder(peak.y - centre.y, static_cast<double>(n));
+  const double dc = std::remainder(peak.x - centre.x, static_cast<double>(n));
+  return std::exp(-0.5 * (dc * dc / (sigma_cols * sigma_cols) + dr * dr / (sigma_rows * sigma_rows)));
+}
+
+PairRegistration Registrar::registerInWindow(const FrameSpectra& older, const FrameSpectra& newer,
+                                            RegistrationMethod method, const RegistrationPrior& prior,
+                                            RegistrationSurfaces* surfaces) {
+  PairRegistration result;
+  const SurfacePeak first = windowPeak(prior);
+  registerOnce(older, newer, method, result, first, surfaces, &prior);
+  // The next peak of the window: tried when the first did not register, and when it competes
+  // with it. Two peaks that both register: one surface of the scene turned and scaled as the
+  // prediction expects, the other an inclined plane, whose perspective reads as a turn and a
+  // zoom. The one whose translation peak stands out where the followed layer was predicted wins.
+  const SurfacePeak second = windowPeak(prior, cv::Point(first.col, first.row));
+  if (!(second.value > 0.0f)) return result;
+  const double first_score = first.value * windowWeight(prior, cv::Point(first.col, first.row));
+  const double second_score = second.value * windowWeight(prior, cv::Point(second.col, second.row));
+  const bool registered = result.status == RegistrationStatus::kOk;
+  if (registered && !(prior.translation_radius > 0.0 && second_score >= kCompetingPeak * first_score)) {
+    return result;
+  }
+  PairRegistration trial;
+  RegistrationSurfaces trial_surfaces;
+  registerOnce(older, newer, method, trial, second, surfaces ? &trial_surfaces : nullptr, &prior);
+  const bool better = registered ? trial.status == RegistrationStatus::kOk &&
+                                       trial.followed_confidence > result.followed_confidence
+                                 : trial.confidence > result.confidence;
+  if (better) {
+    result = std::move(trial);
+    result.rotation_zoom_candidate = 1;
+    if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+  }
+  return result;
+}
+
+void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newer,
+                             RegistrationMethod method, PairRegistration& result,
+                             const SurfacePeak& rotation_zoom_peak, RegistrationSurfaces* surfaces,
+                             const RegistrationPrior* prior) {
+  const int n = context_->size();
+  const double psr_rotation_zoom = registerRotationZoom(method, result, rotation_zoom_peak);
+  if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
+  const double translation_confidence =
+      registerTranslation(older, newer, method, result, true, prior);
+  if (surfaces != nullptr) {
+    surfaces->translation = surface_.clone();
+    surfaces->translation_polar =
+        method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
+    surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
+  }
+  result.confidence =
+      std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
+               translation_confidence);
+  // A rotation or zoom the motion so far rules out (another peak of the whole surface, a half
+  // turn the low-resolution test chose) is not taken, however well its translation matched: a
+  // repetitive pattern matches itself turned by a quarter, or scaled by its period.
+  if (prior != nullptr &&
+      (std::fabs(wrapAngle(result.rotation - prior->rotation)) > prior->rotation_window ||
+       std::fabs(std::log(result.zoom) - prior->log_zoom) > prior->log_zoom_window)) {
+    result.rotation_zoom_implausible = true;
+    result.confidence = 0.0;
+  }
+  result.status = result.confidence >= context_->config().min_confidence
+                      ? RegistrationStatus::kOk
+                      : RegistrationStatus::kLowConfidence;
+}
+
+void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer,
+                                RegistrationMethod method, const RegistrationPrior& prior,
+                                PairRegistration& result, RegistrationSurfaces* surfaces) {
+  const int n = context_->size();
+  const double log_zoom_per_bin = logZoomPerBin();
+  result.rotation = wrapAngle(prior.rotation);
+  result.zoom = std::exp(prior.log_zoom);
+  result.rotation_sigma = prior.rotation_sigma;
+  result.log_zoom_sigma = prior.log_zoom_sigma;
+  result.rotation_zoom_candidate = PairRegistration::kPredicted;
+  if (method == RegistrationMethod::kEnergyVectors) {
+    // The zoom energy vector at the predicted row, for the pattern matching of later pairs.
+    SurfacePeak at;
+    at.sub_row = n / 2 + prior.rotation * n / CV_PI;
+    at.sub_col = n / 2 - prior.log_zoom / log_zoom_per_bin;
+    at.row = ((static_cast<int>(std::lround(at.sub_row)) % n) + n) % n;
+    at.col = ((static_cast<int>(std::lround(at.sub_col)) % n) + n) % n;
+    at.value = rotation_zoom_surface_(at.row, at.col);
+    EnergyVectorOptions options = energyVectorOptions(context_->config());
+    options.cyclic_cols = true;
+    options.row_band = kEnergyRowBand;
+    result.zoom_energy = extractEnergyVector(rotation_zoom_surface_, at, options).values;
+  }
+  if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
+  // The prediction's rotation is not taken modulo a half turn: no half-turn test.
+  const double translation_confidence = registerTranslation(older, newer, method, result, false, &prior);
+  if (surfaces != nullptr) {
+    surfaces->translation = surface_.clone();
+    surfaces->translation_polar =
+        method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
+    surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
+  }
+  // Nothing was measured of the rotation and zoom: the translation alone says whether they fit.
+  result.confidence = translation_confidence;
+  result.status = result.confidence >= context_->config().min_confidence
+                      ? RegistrationStatus::kOk
+                      : RegistrationStatus::kLowConfidence;
+}
+
+void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer) {
+  centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, rotation_zoom_power_);
+  // The full surface: a coarse low-resolution search for the rotation row (to invert only a
+  // band of rows) picked wrong rows on simulated flights, where much of the log-polar
+  // correlation's energy sits at high frequencies. In place: the surface is a view of
+  // rotation_zoom_power_ (its own buffer, so that the translation leaves it for the next
+  // candidate).
+  context_->fft().inverseInPlace(rotation_zoom_power_);
+  rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
+  rotation_zoom_highest_ = findPeak(rotation_zoom_surface_, true, &rotation_zoom_stats_, PeakShape::kBroadened);
+}
+
+double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistration& result,
+                                       const SurfacePeak& peak) {
+  const int n = context_->size();
+  const cv::Mat1f& surface = rotation_zoom_surface_;
+  const double log_zoom_per_bin = logZoomPerBin();
+  // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
+  result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
+  result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
+  result.rotation_zoom_peak = peak.value;
+  if (method == RegistrationMethod::kEnergyVectors) {
+    // Log-zoom columns wrap (circular correlation); only rows near the peak can win.
+    EnergyVectorOptions options = energyVectorOptions(context_->config());
+    options.cyclic_cols = true;
+    options.row_band = kEnergyRowBand;
+    EnergyVector zoom_vector = extractEnergyVector(surface, peak, options);
+    result.rotation_sigma = zoom_vector.row_sigma * CV_PI / n;
+    result.log_zoom_sigma = zoom_vector.col_sigma * log_zoom_per_bin;
+    result.zoom_energy = std::move(zoom_vector.values);
+  } else {
+    const cv::Point2d widths = peakWidths(surface, peak, true);
+    result.rotation_sigma = widths.y * CV_PI / n;
+    result.log_zoom_sigma = widths.x * log_zoom_per_bin;
+  }
+  return peakToSidelobeRatio(surface, peak, rotation_zoom_stats_);
+}
+
+double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
+                                      RegistrationMethod method, PairRegistration& result,
+                                      bool test_half_turn, const RegistrationPrior* prior) {
+  const int n = context_->size();
+  // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
+  // Unless that moves no pixel noticeably: then the older frame's own spectrum (the same
+  // apodized, mean-free image) serves, and the warp and its FFT are saved.
+  const Fft2d& fft = context_->fft();
+  const double corner = std::sqrt(0.5) * n;
+  const double moved = corner * std::abs(std::polar(result.zoom, result.rotation) - 1.0);
+  result.warped = !(moved <= context_->config().identity_warp_px);
+  if (result.warped) {
+    cv::Mat1f warped = fft.inPlaceInput(warped_spectrum_);
+    warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
+                           older.mean);
+    fft.forwardInPlace(warped_spectrum_);
+  }
+  const cv::Mat2f& older_spectrum = result.warped ? warped_spectrum_ : older.spectrum;
+
+  if (test_half_turn && context_->config().resolve_half_turn && prior != nullptr) {
+    // The surface reads the rotation modulo a half turn: the prediction says which.
+    if (std::fabs(wrapAngle(result.rotation - prior->rotation)) > CV_PI / 2.0) {
+      result.half_turn = true;
+      result.rotation = wrapAngle(result.rotation + CV_PI);
+    }
+  } else if (test_half_turn && context_->config().resolve_half_turn) {
+    // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
+    // hypothesis needs no second warp; a low-resolution correlation decides between the two
+    // and only the winner gets the full-size inverse FFT.
+    const double same = lowResolutionPeak(newer.spectrum, older_spectrum, false,
+                                          context_->smallFft(), small_spectrum_, small_surface_);
+    const double turned = lowResolutionPeak(newer.spectrum, older_spectrum, true,
+                                            context_->smallFft(), small_spectrum_, small_surface_);
+    if (turned > same) {
+      result.half_turn = true;
+      result.rotation = wrapAngle(result.rotation + CV_PI);
+    }
+  }
+  // The older frame's noise power also stands for its warp (whose bilinear resampling lowers the
+  // noise at high frequencies a little: those are weighted down a little more).
+  const float older_noise = context_->config().noise_weighting ? older.noise_power : 0.0f;
+  centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn,
+                    SimdKernel::kAuto, newer.noise_power, older_noise);
+  fft.inverseInPlace(cross_power_);
+  surface_ = fft.realView(cross_power_);
+  SurfacePeak peak;
+  const double confidence = chooseTranslationPeak(prior, peak, result);
+  result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
+  result.direction = std::atan2(result.translation.y, result.translation.x);
+  result.shift = std::hypot(result.translation.x, result.translation.y);
+  result.translation_peak = peak.value;
+
+  if (method == RegistrationMethod::kEnergyVectors) {
+    // Polar unwrap: the depths of the scene lie along one direction at different radii (2.6).
+    // Only a band of direction rows around the peak's direction can win (see row_band).
+    const int band = kPolarBandHalfWidth;
+    const int centre_row = static_cast<int>(std::lround(result.direction * n / (2.0 * CV_PI)));
+    polar_first_row_ = centre_row - band;
+    context_->polarRows(surface_, polar_first_row_, 2 * band + 1, polar_);
+    const SurfacePeak polar_peak = findPeak(polar_, false);
+    // Radius columns do not wrap; the rho ~ 0 column is suppressed (spec 2.4 step 2).
+    EnergyVectorOptions options = energyVectorOptions(context_->config());
+    options.cyclic_cols = false;
+    options.suppress_low_cols = true;
+    EnergyVector shift_vector = extractEnergyVector(polar_, polar_peak, options);
+    result.direction_sigma = shift_vector.row_sigma * 2.0 * CV_PI / n;
+    result.shift_sigma = shift_vector.col_sigma * context_->polarRadiusStep();
+    result.translation_energy = std::move(shift_vector.values);
+  } else {
+    const cv::Point2d widths = peakWidths(surface_, peak, true);
+    result.shift_sigma = std::max(widths.x, widths.y);
+    result.direction_sigma = std::min(CV_PI, result.shift_sigma / std::max(result.shift, 1e-9));
+  }
+  return confidence;
+}
+
+double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
+                                        PairRegistration& result) {
+  const int n = context_->size();
+  // The noise weights smooth the peak: its sub-pixel position is a Gaussian's.
+  const PeakShape shape = context_->config().noise_weighting ? PeakShape::kGaussian : PeakShape::kDirichlet;
+  SurfaceStats stats;
+  peak = findPeak(surface_, true, &stats, shape);
+  const double global = confidenceFrom(peakToSidelobeRatio(surface_, peak, stats),
+                                       kTranslationPsrFloor, kTranslationPsrGood);
+  result.translation_from_window = false;
+  result.translation_implausible = false;
+  result.followed_confidence = 0.0;
+  if (prior == nullptr || !(prior->translation_radius > 0.0)) return global;
+
+  const double radius = std::min(prior->translation_radius, 0.25 * n);
+  const cv::Point2d predicted = prior->translation;
+  const cv::Point2d highest(peak.sub_col - n / 2, peak.sub_row - n / 2);
+  const int half = static_cast<int>(std::ceil(radius));
+  // The window is a three-sigma bound on the prediction: within it, a peak's height is weighted
+  // by a Gaussian of a third of its radius, so that a repetitive pattern's alias near the edge
+  // wins over a weaker peak at the predicted place only by being much higher.
+  // The noise of a correlation surface reaches higher the more cells it has: the floors were
+  // set for the largest of the N^2 cells; for the largest of a window's cells they shrink with
+  // the logarithm of the count (the tail of the surface's values is about exponential).
+  const double cells = (2.0 * half + 1.0) * (2.0 * half + 1.0);
+  const double shrink = std::log(cells) / std::log(static_cast<double>(n) * n);
+  // Values below half that floor could not make a peak of any confidence: not searched.
+  const double count = static_cast<double>(surface_.total());
+  const double mean = stats.abs_sum / count;
+  const double deviation = std::sqrt(std::max(stats.square_sum / count - mean * mean, 0.0));
+  const float noise_level = static_cast<float>(mean + 0.5 * kTranslationPsrFloor * shrink * deviation);
+  const SurfacePeak near = findPeakInWindow(
+      surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
+                          static_cast<int>(std::lround(n / 2 + predicted.y))),
+      half, half, true, shape, cv::Point2d(radius / 3.0, radius / 3.0), cv::Point(-10, -10), noise_level);
+  const double near_confidence = confidenceFrom(peakToSidelobeRatio(surface_, near, stats),
+                                                kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink);
+  result.followed_translation = cv::Point2d(near.sub_col - n / 2, near.sub_row - n / 2);
+  result.followed_confidence = near_confidence;
+  // Against the highest peak, a lower one counts as much less.
+  const double windowed =
+      near_confidence * std::clamp(double(near.value) / std::max(double(peak.value), 1e-12), 0.0, 1.0);
+  // The highest peak is plausible in the window, or on the predicted direction at up to twice or
+  // half the predicted length (another depth layer of the same motion).
+  const double length = std::hypot(predicted.x, predicted.y);
+  bool plausible = std::hypot(highest.x - predicted.x, highest.y - predicted.y) <= radius;
+  if (!plausible && length > radius) {
+    const cv::Point2d along = predicted * (1.0 / length);
+    const double projection = highest.x * along.x + highest.y * along.y;
+    const double across = std::fabs(highest.y * along.x - highest.x * along.y);
+    plausible = across <= radius && projection >= 0.5 * length && projection <= 2.0 * length;
+  }
+  if (plausible && global >= windowed) return global;
+  if (windowed > 0.0) {
+    peak = near;
+    result.translation_from_window = true;
+    return windowed;
+  }
+  if (plausible) return global;
+  result.translation_implausible = true;
+  return 0.0;
+}
+
+}  // namespace oefmt

@@ -1,0 +1,444 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The command-line tools end to end: simulate -> folder + bag, folder -> bag, evaluate; their
+// exit codes and messages for bad input.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "support/temp_dir.h"
+#include "oefmt/io/dataset.h"
+#include "oefmt/ros/bag_io.h"
+
+namespace oefmt {
+namespace {
+
+using test::TempDir;
+
+struct ToolRun {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Runs `command` (a tool path and arguments, no shell characters) and collects its output.
+ToolRun run(const TempDir& dir, const std::string& command) {
+  const std::string out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const int raw = std::system((command + " >" + out + " 2>" + err + " </dev/null").c_str());
+  ToolRun result;
+  result.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  result.out = readFile(out);
+  result.err = readFile(err);
+  return result;
+}
+
+// A 3-frame 128 x 128 flight in dir/flight (PNG images, ground truth, cam_param.yaml).
+void simulateThreeFrames(const TempDir& dir) {
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
+                                    (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+}
+
+TEST(Tools, SimulateConvertAndEvaluate) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --size 96 --frames 6 --length 15 --seed 3 --bag " +
+                                    (dir / "sim.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  EXPECT_NE(simulate.out.find("overlap"), std::string::npos);
+  EXPECT_EQ(simulate.err.find('\r'), std::string::npos);  // no progress bar when not a terminal
+
+  const FolderDataset dataset(dir / "flight");
+  EXPECT_EQ(dataset.size(), 6u);
+  EXPECT_EQ(BagImageReader(dir / "sim.bag").size(), 6u);
+
+  const ToolRun convert = run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " --quiet " + (dir / "flight") + " " + (dir / "conv.bag"));
+  ASSERT_EQ(convert.status, 0) << convert.err;
+  BagImageReader reader(dir / "conv.bag");
+  BagFrame frame;
+  ASSERT_TRUE(reader.next(frame));
+  EXPECT_EQ(cv::norm(frame.image, dataset.loadImage(0), cv::NORM_INF), 0.0);
+
+  const std::string truth = dir / "flight/groundtruth.tum";
+  const ToolRun evaluate = run(dir, std::string(OEFMT_EVALUATE) + " --json-only " + truth + " " + truth);
+  ASSERT_EQ(evaluate.status, 0) << evaluate.err;
+  EXPECT_EQ(evaluate.out.rfind("{\"estimate_poses\":6,", 0), 0u) << evaluate.out;
+  EXPECT_NE(evaluate.out.find("\"rmse\":0"), std::string::npos) << evaluate.out;
+}
+
+// The corpus options: a small flight with every one of them, a spin, and their one-line errors.
+TEST(Tools, SimulateCorpusOptions) {
+  TempDir dir;
+  const std::string simulate = std::string(OEFMT_SIMULATE) + " --size 96 --frames 3 ";
+  ToolRun result = run(dir, simulate + "--length 6 --texture-style natural,brick,tiles --contrast 10 --noise-grey 5 "
+                                      "--flicker 0.1 --walls --climb -1 --climb-profile hill --track line " +
+                                (dir / "varied"));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("ground natural, 1 brick "), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("rescaled to grey std 10.0"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("walls"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("grey std    of the written frames: mean "), std::string::npos) << result.out;
+  EXPECT_EQ(FolderDataset(dir / "varied").size(), 3u);
+
+  result = run(dir, simulate + "--track spin --spin-rate -10 " + (dir / "spin"));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("spin at the origin, 3 frames, yaw 0.0 deg turning -10.00 deg per frame"),
+            std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("altitude    20.000 m"), std::string::npos) << result.out;
+
+  const std::pair<std::string, std::string> bad[] = {
+      {"--track spin --overlap 0.8", "--overlap does not apply to --track spin"},
+      {"--track spin --length 10", "--length does not apply to --track spin"},
+      {"--track spin --climb 2", "--climb does not apply to --track spin"},
+      {"--spin-rate 5", "--spin-rate applies to --track spin only"},
+      {"--track spin --spin-rate 200", "--spin-rate must be in (-180, 180) deg"},
+      {"--climb-profile ramp", "--climb-profile ramp needs --track line"},
+      {"--climb-profile up", "--climb-profile must be ramp or hill"},
+      {"--texture-style cells,marble", "--texture-style: unknown texture style 'marble'"},
+      {"--contrast 0", "--contrast must be in (0, 127.5]"},
+      {"--flicker 1", "--flicker must be in [0, 1)"},
+      {"--noise-grey -1", "--noise-grey must be >= 0"},
+      {"--track line --altitude 10 --climb -8", "descend less"},
+  };
+  for (const auto& [options, message] : bad) {
+    result = run(dir, simulate + options + " " + (dir / "bad"));
+    EXPECT_EQ(result.status, 2) << options;
+    EXPECT_NE(result.err.find(message), std::string::npos) << options << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  }
+}
+
+TEST(Tools, ExitCodesAndMessages) {
+  TempDir dir;
+  EXPECT_EQ(run(dir, std::string(OEFMT_SIMULATE) + " --help").status, 0);
+  EXPECT_EQ(run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " --help").status, 0);
+  EXPECT_EQ(run(dir, std::string(OEFMT_EVALUATE) + " --help").status, 0);
+
+  ToolRun bad = run(dir, std::string(OEFMT_SIMULATE) + " --track square " + (dir / "x"));
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("unknown track 'square'"), std::string::npos) << bad.err;
+  bad = run(dir, std::string(OEFMT_SIMULATE) + " --frames");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("needs a value"), std::string::npos) << bad.err;
+
+  bad = run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " " + (dir / "missing") + " " + (dir / "out.bag"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("missing"), std::string::npos) << bad.err;
+
+  std::ofstream(dir / "a.tum") << "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n";
+  std::ofstream(dir / "b.tum") << "5 0 0 0 0 0 0 1\n6 1 0 0 0 0 0 1\n";
+  bad = run(dir, std::string(OEFMT_EVALUATE) + " " + (dir / "a.tum") + " " + (dir / "b.tum"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("--match index"), std::string::npos) << bad.err;
+  const ToolRun by_index = run(dir, std::string(OEFMT_EVALUATE) + " --match index " + (dir / "a.tum") + " " + (dir / "b.tum"));
+  EXPECT_EQ(by_index.status, 0) << by_index.err;
+  EXPECT_EQ(run(dir, std::string(OEFMT_EVALUATE) + " --tolerance x a b").status, 2);
+}
+
+}  // namespace
+}  // namespace oefmt
+
+namespace oefmt {
+namespace {
+
+// Truncates a file to `bytes` (a PNG cut short by a full disk or a copy that was interrupted).
+void truncateFile(const std::string& path, std::size_t bytes) {
+  const std::string text = readFile(path);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(text.data(), static_cast<std::streamsize>(std::min(bytes, text.size())));
+}
+
+std::size_t trajectoryLines(const std::string& path) {
+  std::ifstream in(path);
+  std::size_t lines = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] != '#') ++lines;
+  }
+  return lines;
+}
+
+// oefmt_offline on a folder whose 6th image is truncated and on a corrupt bag: a message naming
+// the file, exit status 1, and the trajectory up to the bad frame kept and valid.
+TEST(Tools, OfflineKeepsTheTrajectoryOnBadInput) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 10 --length 25 --seed 4 --bag " +
+                                    (dir / "flight.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  const ToolRun good = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                    " --output " + (dir / "good.tum"));
+  ASSERT_EQ(good.status, 0) << good.err;
+  EXPECT_EQ(trajectoryLines(dir / "good.tum"), 10u);
+
+  truncateFile(dir / "flight/Images/0006.png", 200);
+  const ToolRun bad = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                   " --output " + (dir / "bad.tum"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("0006.png"), std::string::npos) << bad.err;
+  EXPECT_EQ(trajectoryLines(dir / "bad.tum"), 5u);  // frames 0..4, each line complete
+  const ToolRun evaluate = run(dir, std::string(OEFMT_EVALUATE) + " --match index --json-only " +
+                                        (dir / "bad.tum") + " " + (dir / "flight/groundtruth.tum"));
+  EXPECT_EQ(evaluate.status, 0) << evaluate.err;  // the partial file is a valid trajectory
+
+  truncateFile(dir / "flight.bag", 5000);
+  const ToolRun corrupt = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --bag " + (dir / "flight.bag") +
+                                       " --output " + (dir / "bag.tum"));
+  EXPECT_EQ(corrupt.status, 1);
+  EXPECT_NE(corrupt.err.find("flight.bag"), std::string::npos) << corrupt.err;
+
+  const ToolRun missing = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "nowhere") +
+                                       " --output " + (dir / "none.tum"));
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("nowhere"), std::string::npos) << missing.err;
+}
+
+// The poses (x y z qx qy qz qw) of a TUM file, without the stamps.
+std::vector<std::vector<double>> poses(const std::string& path) {
+  std::vector<std::vector<double>> rows;
+  std::istringstream text(readFile(path));
+  std::string line;
+  while (std::getline(text, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double stamp = 0.0;
+    std::vector<double> pose(7);
+    fields >> stamp;
+    for (double& value : pose) fields >> value;
+    rows.push_back(pose);
+  }
+  return rows;
+}
+
+// Largest difference between two trajectories' poses (infinite when their lengths differ).
+double largestDifference(const std::vector<std::vector<double>>& a, const std::vector<std::vector<double>>& b) {
+  if (a.size() != b.size()) return HUGE_VAL;
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t j = 0; j < a[i].size(); ++j) largest = std::max(largest, std::fabs(a[i][j] - b[i][j]));
+  }
+  return largest;
+}
+
+// A folder's cam_param.yaml and a bag's CameraInfo set up the same undistortion: the same poses
+// from both, each run saying what it undoes; --no-undistort takes the frames as they are.
+TEST(Tools, OfflineUndistortsFoldersAndBagsAlike) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --track line --frames 6 --length 10 " +
+                                    "--seed 4 --k1 -0.2 --k2 0.05 --bag " + (dir / "flight.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --config " + (dir / "size128.yaml");
+  std::ofstream(dir / "size128.yaml") << "registration:\n   size: 128\n";
+  const ToolRun folder = run(dir, offline + " --images " + (dir / "flight") + " --output " + (dir / "folder.tum"));
+  ASSERT_EQ(folder.status, 0) << folder.err;
+  EXPECT_NE(folder.err.find("undistorting (cam_param.yaml: k1 -0.2 k2 0.05): 128x128 working frames, fx = fy"), std::string::npos)
+      << folder.err;
+  const ToolRun bag = run(dir, offline + " --bag " + (dir / "flight.bag") + " --output " + (dir / "bag.tum"));
+  ASSERT_EQ(bag.status, 0) << bag.err;
+  EXPECT_NE(bag.err.find("undistorting (CameraInfo on /camera/camera_info: k1 -0.2 k2 0.05)"), std::string::npos)
+      << bag.err;
+  // Equal up to float rounding (FFTW picks its algorithms by timing, per process).
+  EXPECT_LT(largestDifference(poses(dir / "folder.tum"), poses(dir / "bag.tum")), 1e-6);
+  ASSERT_EQ(poses(dir / "folder.tum").size(), 6u);
+  EXPECT_GT(largestDifference({poses(dir / "folder.tum")[1]}, {poses(dir / "folder.tum")[0]}), 0.1);  // it moved
+
+  const ToolRun raw = run(dir, offline + " --no-undistort --images " + (dir / "flight") + " --output " + (dir / "raw.tum"));
+  ASSERT_EQ(raw.status, 0) << raw.err;
+  EXPECT_EQ(raw.err.find("undistorting"), std::string::npos) << raw.err;
+  EXPECT_GT(largestDifference(poses(dir / "raw.tum"), poses(dir / "folder.tum")), 0.1);
+}
+
+// A calibration of another resolution is said in one line; an unusable cam_param.yaml stops the
+// run with one line naming the file and the problem (exit status 1).
+TEST(Tools, OfflineSaysHowTheCalibrationIsUsedAndRefusesUnusableOnes) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const std::string yaml = dir / "flight/cam_param.yaml";
+  const std::string command = std::string(OEFMT_OFFLINE) + " --images " + (dir / "flight") + " --output " + (dir / "x.tum");
+  const std::string quiet = std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") + " --output " + (dir / "x.tum");
+  const auto camParam = [&](const std::string& distortion) {
+    std::ofstream(yaml) << "%YAML:1.0\nCamera.fx: 2955.7\nCamera.fy: 2949.9\nCamera.cx: 2023.1\n"
+                           "Camera.cy: 1510.7\nCamera.width: 4056\nCamera.height: 3040\n"
+                        << distortion;
+  };
+  camParam("");
+  const ToolRun authors = run(dir, command);
+  ASSERT_EQ(authors.status, 0) << authors.err;
+  EXPECT_NE(authors.err.find("oefmt_offline: cam_param.yaml describes a 4056x3040 camera; the 128x128 images are "
+                             "taken as its centred 3040x3040 crop resized: fx 124.5 px"),
+            std::string::npos)
+      << authors.err;
+  const auto expectRefused = [&](const std::string& distortion, const std::string& part) {
+    camParam(distortion);
+    const ToolRun refused = run(dir, quiet);
+    EXPECT_EQ(refused.status, 1) << distortion;
+    EXPECT_NE(refused.err.find(part), std::string::npos) << refused.err;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  };
+  expectRefused("Camera.k1: -5.0\n", "error: cam_param.yaml: lens distortion (k1 -5) cannot be undone");
+  expectRefused("Camera.k1: 1e300\nCamera.k2: 1e300\n", "cannot be undone");
+  expectRefused("Camera.k2: nan\n", "Camera.k2 is not finite");
+  expectRefused("Camera.type: \"KannalaBrandt8\"\n", "Camera.type 'KannalaBrandt8' is not supported");
+}
+
+// Frames smaller than registration.size are upscaled, which registers worse: a warning names the
+// size to set; with that size, none.
+TEST(Tools, OfflineWarnsWhenFramesAreUpscaled) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const ToolRun upscaled = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                        " --output " + (dir / "a.tum"));
+  EXPECT_EQ(upscaled.status, 0) << upscaled.err;
+  EXPECT_NE(upscaled.err.find("upscaled to registration.size 512"), std::string::npos) << upscaled.err;
+  EXPECT_NE(upscaled.err.find("at most 128"), std::string::npos) << upscaled.err;
+  {
+    std::ofstream config(dir / "size128.yaml");
+    config << "%YAML:1.0\nregistration:\n  size: 128\n";
+  }
+  const ToolRun native = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --config " + (dir / "size128.yaml") +
+                                      " --images " + (dir / "flight") + " --output " + (dir / "b.tum"));
+  EXPECT_EQ(native.status, 0) << native.err;
+  EXPECT_EQ(native.err.find("upscaled"), std::string::npos) << native.err;
+}
+
+// The first column of a TUM trajectory's poses.
+std::vector<double> trajectoryStamps(const std::string& path) {
+  std::vector<double> stamps;
+  std::istringstream lines(readFile(path));
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty() && line[0] != '#') stamps.push_back(std::stod(line));
+  }
+  return stamps;
+}
+
+// A folder's frames carry its timestamps.txt (the motion model needs the real frame interval);
+// a timestamps.txt that cannot be used is said, even with --quiet, and the frames are indexed.
+TEST(Tools, OfflineStampsFramesWithTimestampsAndSaysWhenItCannot) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight");
+  const ToolRun stamped = run(dir, offline + " --output " + (dir / "a.tum"));
+  ASSERT_EQ(stamped.status, 0) << stamped.err;
+  EXPECT_EQ(stamped.err.find("timestamps.txt"), std::string::npos) << stamped.err;
+  FolderDataset dataset(dir / "flight");
+  ASSERT_TRUE(dataset.hasTimestamps());
+  const std::vector<double> stamps = trajectoryStamps(dir / "a.tum");
+  ASSERT_EQ(stamps.size(), 3u);
+  for (std::size_t k = 0; k < stamps.size(); ++k) EXPECT_NEAR(stamps[k], dataset.timestamp(k), 1e-6) << k;
+  EXPECT_GT(stamps[1] - stamps[0], 0.0);
+  EXPECT_LT(stamps[1] - stamps[0], 0.9);  // the render's interval, not the index's second
+
+  const std::vector<std::pair<std::string, std::string>> broken = {
+      {"1.0\n1.2\n", "it has 2 stamps for 3 images"},
+      {"1.0\nsoon\n1.4\n", "line 2 'soon' is not a time"},
+      {"1.0\n1.4\n1.2\n", "stamps do not increase at line 3"}};
+  for (const auto& [text, message] : broken) {
+    {
+      std::ofstream file(dir / "flight/timestamps.txt");
+      file << text;
+    }
+    const ToolRun indexed = run(dir, offline + " --output " + (dir / "b.tum"));
+    ASSERT_EQ(indexed.status, 0) << indexed.err;
+    EXPECT_NE(indexed.err.find("warning: timestamps.txt ignored"), std::string::npos) << indexed.err;
+    EXPECT_NE(indexed.err.find(message), std::string::npos) << indexed.err;
+    EXPECT_EQ(trajectoryStamps(dir / "b.tum"), (std::vector<double>{0.0, 1.0, 2.0})) << message;
+  }
+}
+
+// OpenCV's imgcodecs (with GDAL and ~150 more libraries: 0.13 s of start-up, 40 MB) is loaded
+// only for an image that needs it: not for the PNGs the fast path decodes; for JPEGs through the
+// plugin beside liboefmt_io.so; and without the plugin, a clear error.
+TEST(Tools, OfflineLoadsImgcodecsOnlyForImagesThatNeedIt) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  // LD_DEBUG=files: the dynamic loader names every library it loads (on stderr).
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") + " --output ";
+  const ToolRun png = run(dir, "env LD_DEBUG=files " + offline + (dir / "png.tum"));
+  ASSERT_EQ(png.status, 0) << png.err;
+  EXPECT_EQ(png.err.find("imgcodecs"), std::string::npos) << png.err;
+  EXPECT_EQ(trajectoryLines(dir / "png.tum"), 3u);
+
+  // The same frames as JPEGs (under their .png names: decoding goes by content).
+  for (const char* name : {"0001.png", "0002.png", "0003.png"}) {
+    const std::string path = dir / (std::string("flight/Images/") + name);
+    std::vector<std::uint8_t> jpeg;
+    ASSERT_TRUE(cv::imencode(".jpg", cv::imread(path, cv::IMREAD_UNCHANGED), jpeg));
+    std::ofstream(path, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(jpeg.data()), static_cast<std::streamsize>(jpeg.size()));
+  }
+  const ToolRun jpeg = run(dir, "env LD_DEBUG=files " + offline + (dir / "jpeg.tum"));
+  ASSERT_EQ(jpeg.status, 0) << jpeg.err;
+  EXPECT_NE(jpeg.err.find("liboefmt_image_codecs.so"), std::string::npos) << jpeg.err;
+  EXPECT_NE(jpeg.err.find("libopencv_imgcodecs"), std::string::npos) << jpeg.err;
+  EXPECT_EQ(trajectoryLines(dir / "jpeg.tum"), 3u);
+
+  // liboefmt_io.so alone in a folder ahead of the build's (LD_LIBRARY_PATH beats RUNPATH):
+  // no plugin beside it, none on the search path.
+  const std::string lib = dir / "lib";
+  ASSERT_EQ(std::system(("mkdir -p " + lib + " && cp " + OEFMT_IO_LIBRARY + " " + lib).c_str()), 0);
+  const ToolRun missing = run(dir, "env LD_LIBRARY_PATH=" + lib + " " + offline + (dir / "missing.tum"));
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("0001.png"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("cannot load the image codec plugin liboefmt_image_codecs.so"), std::string::npos)
+      << missing.err;
+}
+
+// A folder of tiny (40 x 30) frames: a clear message with the size, exit status 1.
+TEST(Tools, OfflineRefusesTinyFrames) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  for (const char* name : {"0001.png", "0002.png", "0003.png"}) {
+    const std::string path = dir / (std::string("flight/Images/") + name);
+    ASSERT_TRUE(std::ifstream(path).good()) << path;
+    ASSERT_TRUE(cv::imwrite(path, cv::Mat(30, 40, CV_8UC1, cv::Scalar(90))));
+  }
+  const ToolRun tiny = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --images " + (dir / "flight") +
+                                    " --output " + (dir / "tiny.tum"));
+  EXPECT_EQ(tiny.status, 1);
+  EXPECT_NE(tiny.err.find("0001.png: image of 40x30"), std::string::npos) << tiny.err;
+}
+
+// scripts/measure_speed.py: a line with the figures of each run, the summaries, and a clear
+// error when there is no oefmt_offline to run.
+TEST(Tools, MeasureSpeedReportsEveryRun) {
+  TempDir dir;
+  ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
+  const std::string script = std::string("python3 ") + OEFMT_MEASURE_SPEED;
+  const ToolRun speed = run(dir, script + " --offline " + OEFMT_OFFLINE + " --runs 2 --images " +
+                                     (dir / "flight"));
+  ASSERT_EQ(speed.status, 0) << speed.err;
+  for (const char* expected : {"run 1: ", "run 2: ", "ms per frame (3 frames), CPU ", "peak memory ",
+                               "all runs: 2 runs, median ", "runs with steal below 2 %: "}) {
+    EXPECT_NE(speed.out.find(expected), std::string::npos) << expected << " in\n" << speed.out;
+  }
+  EXPECT_EQ(speed.out.find("run 3: "), std::string::npos) << speed.out;
+
+  const ToolRun missing = run(dir, script + " --offline " + (dir / "none") + " --images " + (dir / "flight"));
+  EXPECT_NE(missing.status, 0);
+  EXPECT_NE(missing.err.find("no executable oefmt_offline at " + (dir / "none")), std::string::npos)
+      << missing.err;
+
+  // A run that fails: its exit status and oefmt_offline's own message, no Python traceback.
+  const ToolRun failed = run(dir, script + " --offline " + OEFMT_OFFLINE + " --images " + (dir / "nowhere"));
+  EXPECT_NE(failed.status, 0);
+  EXPECT_NE(failed.err.find("measure_speed: oefmt_offline failed (exit status "), std::string::npos) << failed.err;
+  EXPECT_NE(failed.err.find("nowhere"), std::string::npos) << failed.err;
+  EXPECT_EQ(failed.err.find("Traceback"), std::string::npos) << failed.err;
+}
+
+}  // namespace
+}  // namespace oefmt
