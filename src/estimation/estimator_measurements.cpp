@@ -231,8 +231,8 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
     // translation energy peak of pair 1-2 with one of pair 0-1 within layer_gate of it over the
     // frame intervals) give the speed ratio, which holds for every layer of the rigid scene. Of
     // those, the ratio nearest to steady: a neighbour in depth matched to another layer's peak
-    // is further off (A/B on dense three-level flights: median 0.60 m, highest layer 0.40 m,
-    // nearest 0.34 m ATE on the worst).
+    // is further off, and on dense three-level flights the nearest ratio tracked better than the
+    // median or the highest layer's.
     const std::vector<EnergyPeak> peaks01 = energyPeaks(translation01, tracking.layer_min_fraction);
     for (const EnergyPeak& p : energyPeaks(registration12.translation_energy, min_fraction)) {
       const double expected = p.bin / intervals;  // where pair 0-1 saw this layer

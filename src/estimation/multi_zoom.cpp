@@ -85,7 +85,8 @@ MultiZoomTranslation MultiZoomTranslator::analyse(const FrameSpectra& older, con
   }
   if (!(weight_total > 0.0)) return result;
 
-  // The no-motion column dominates every direction once the shift is large (spec 2.4 step 2).
+  // The no-motion column dominates every direction once the shift is large (doc/method.md,
+  // Translation).
   cv::Point peak;
   cv::minMaxLoc(fused_, nullptr, nullptr, nullptr, &peak);
   const int first_col = peak.x > 20 ? 5 : 0;

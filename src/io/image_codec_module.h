@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Private to src/core and src/codecs: OpenCV's imgcodecs, loaded on first use. Linking it costs
-// every process ~0.13 s of start-up and ~40 MB (it pulls in GDAL, HDF5, Poppler, ... about 150
+// every process start-up time and memory (it pulls in GDAL, HDF5, Poppler, ... about 150
 // libraries) although the common PNGs never need it (decodePngFast). So the core reaches it
 // through liboefmt_image_codecs.so (src/codecs), a plugin it dlopen()s the first time an image
 // needs it (another format, an unusual PNG, an encoding).

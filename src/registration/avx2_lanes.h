@@ -20,11 +20,10 @@ static inline void deinterleave(__m256 a, __m256 b, __m256& even, __m256& odd) {
 
 /// Four pairs of adjacent floats, at float offsets `at0`, `at1` (the low 128 bits) and `at2`,
 /// `at3` (the high 128 bits) from `base`: the two horizontal neighbours of a bilinear sample in
-/// one 64-bit load each. Plain loads, not a hardware gather: on this project's AMD Zen 3 host
-/// the log-polar resampling took 1.17 ms with 64-bit gathers and 0.83 ms with these loads
-/// (bit-identical). The low pair goes through memcpy (floats are not read through a double
-/// pointer; it compiles to the same vmovq as _mm_load_sd); movhps's intrinsic reads through a
-/// may-alias type.
+/// one 64-bit load each. Plain loads, not a hardware gather: the gathers were slower on the AMD
+/// Zen 3 host the kernels were tuned on, and the loads give the same bits (doc/performance.md).
+/// The low pair goes through memcpy (floats are not read through a double pointer; it compiles to
+/// the same vmovq as _mm_load_sd); movhps's intrinsic reads through a may-alias type.
 static inline __m256 loadPairs(const float* base, unsigned at0, unsigned at1, unsigned at2,
                                unsigned at3) {
   auto low64 = [base](unsigned at) {

@@ -70,7 +70,7 @@ EnergyVector extractEnergyVector(const cv::Mat1f& surface, const SurfacePeak& pe
                                  const EnergyVectorOptions& options) {
   const int rows = surface.rows;
   const int cols = surface.cols;
-  // The polar surface has a bright rho ~ 0 column whenever the motion is not small (2.4 step 2).
+  // The polar surface has a bright rho ~ 0 column whenever the motion is not small.
   const int first_col = (options.suppress_low_cols && peak.sub_col > 20.0) ? 5 : 0;
 
   std::vector<float> row_energy(rows, 0.0f);
@@ -121,7 +121,8 @@ EnergyVector extractEnergyVector(const cv::Mat1f& surface, const SurfacePeak& pe
   result.row = row;
   result.row_sigma = gaussianWidth(row_energy.data(), rows, k + mu, block, true);
 
-  // Fuse the block with Gaussian weights centred on mu (FIX of the reciprocal-Gaussian weights).
+  // Fuse the block with Gaussian weights centred on mu (not the paper's reciprocal Gaussian:
+  // doc/method.md, Deviations from the paper).
   std::vector<double> weights(2 * block + 1);
   double weights_total = 0.0;
   const double sigma = std::max(result.row_sigma, 1e-3);

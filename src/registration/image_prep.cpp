@@ -49,8 +49,8 @@ struct PixelMoments {
 };
 
 // Mean, mean square and largest |pixel| in one pass of vectorised row statistics (float per row,
-// double over rows; cv::sum, cv::norm, cv::mean and cv::minMaxLoc took four passes, 0.4 ms at
-// 512^2). Squares of huge float pixels overflow a float row sum: double sums then.
+// double over rows; cv::sum, cv::norm, cv::mean and cv::minMaxLoc take four passes over the
+// frame). Squares of huge float pixels overflow a float row sum: double sums then.
 PixelMoments pixelMoments(const cv::Mat1f& grey) {
   const detail::SurfaceTotals totals =
       detail::surfaceTotals(grey[0], static_cast<int>(grey.step1()), grey.rows, grey.cols,

@@ -26,7 +26,8 @@ constexpr double kRotationZoomPsrFloor = 6.0;
 constexpr double kRotationZoomPsrGood = 20.0;
 
 // Rows of the polar unwrap (and of the rotation/zoom surface) that compete for the energy row:
-// rows further than 10 from the peak are overruled by the peak row anyway (spec 2.4 step 4b).
+// rows further than 10 from the peak are overruled by the peak row anyway (doc/method.md,
+// Energy vectors).
 constexpr int kPolarBandHalfWidth = 16;
 constexpr int kEnergyRowBand = 12;
 
@@ -322,7 +323,7 @@ double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistrati
   const int n = context_->size();
   const cv::Mat1f& surface = rotation_zoom_surface_;
   const double log_zoom_per_bin = logZoomPerBin();
-  // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (spec 2.5).
+  // Rows span pi: theta = (row - N/2) pi / N; columns: ln s = -(col - N/2) ln b (doc/method.md).
   result.rotation = (peak.sub_row - n / 2) * CV_PI / n;
   result.zoom = std::exp(-(peak.sub_col - n / 2) * log_zoom_per_bin);
   result.rotation_zoom_peak = peak.value;
@@ -347,7 +348,7 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                                       RegistrationMethod method, PairRegistration& result,
                                       bool test_half_turn, const RegistrationPrior* prior) {
   const int n = context_->size();
-  // Bring the older frame onto the newer one's rotation and zoom, then correlate (spec 2.6).
+  // Bring the older frame onto the newer one's rotation and zoom, then correlate.
   // Unless that moves no pixel noticeably: then the older frame's own spectrum (the same
   // apodized, mean-free image) serves, and the warp and its FFT are saved.
   const Fft2d& fft = context_->fft();
@@ -396,14 +397,14 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   result.translation_peak = peak.value;
 
   if (method == RegistrationMethod::kEnergyVectors) {
-    // Polar unwrap: the depths of the scene lie along one direction at different radii (2.6).
+    // Polar unwrap: the depths of the scene lie along one direction at different radii.
     // Only a band of direction rows around the peak's direction can win (see row_band).
     const int band = kPolarBandHalfWidth;
     const int centre_row = static_cast<int>(std::lround(result.direction * n / (2.0 * CV_PI)));
     polar_first_row_ = centre_row - band;
     context_->polarRows(surface_, polar_first_row_, 2 * band + 1, polar_);
     const SurfacePeak polar_peak = findPeak(polar_, false);
-    // Radius columns do not wrap; the rho ~ 0 column is suppressed (spec 2.4 step 2).
+    // Radius columns do not wrap; the rho ~ 0 column is suppressed (see energy_vector.cpp).
     EnergyVectorOptions options = energyVectorOptions(context_->config());
     options.cyclic_cols = false;
     options.suppress_low_cols = true;

@@ -28,8 +28,7 @@ inline void prefetchForRead(const float* address) {
 // Asks for the cache lines the samples of `line` will read (both bilinear rows), one touch per
 // 64-byte line crossed. The hardware prefetcher does not follow a sampled line, which drifts
 // across source rows: a source that is not already in cache (the older frame, last used when it
-// was analysed) made the warp about 2.5 times slower than a cached one
-// (BM_Stage_WarpUncachedOlder).
+// was analysed) made the warp much slower than a cached one (BM_Stage_WarpUncachedOlder).
 void prefetchLine(const detail::LineSamples& line) {
   constexpr float kFloatsPerCacheLine = 16.0f;
   // Samples per new cache line along the line; 1 when every sample may need one, and when the

@@ -198,7 +198,7 @@ namespace {
 // Colours of cbrt(t) for t = |v| / max|v| in [0, 1], indexed by the top 16 bits of t's float
 // (exponent and 7 mantissa bits: t is known to 1/256, its cube root to 1/768 — under one of the
 // 256 levels). One table lookup per pixel instead of three passes (pow, normalise, colour map):
-// 1.7 ms -> 0.6 ms per 512 x 512 surface (same minute), rendered for every frame while subscribed.
+// the surfaces are rendered for every frame while subscribed, so the cost counts.
 constexpr std::uint32_t kOneTopBits = 0x3F80;  // top 16 bits of 1.0f
 
 const std::vector<cv::Vec3b>& cubeRootHeatTable() {

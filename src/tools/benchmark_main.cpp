@@ -108,8 +108,8 @@ std::pair<double, double> cpuTicks() {
 }
 
 // Runs `body` as the benchmark loop and reports its time per iteration in FFT pairs measured
-// just before and after it ("fft_pairs"): a figure the host's drift (up to 2-3x here) does not
-// change, to compare with the README's targets (8.9 and 6.1 FFT pairs). "steal_pct":
+// just before and after it ("fft_pairs"): a figure the host's speed drift does not change, to
+// compare with the targets in doc/performance.md (which are in FFT pairs). "steal_pct":
 // the share of the CPUs' time the hypervisor took meanwhile (a shared virtual machine's time
 // is only comparable when it is near 0).
 template <typename Body>
@@ -179,8 +179,8 @@ void BM_RegisterCachedSpectraClassic(benchmark::State& state) {
 }
 BENCHMARK(BM_RegisterCachedSpectraClassic)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
-// The yardstick on its own: one fftPair. The host's speed drifts by up to 2-3x; a pair's time
-// divided by this one is a figure that does not (the README's targets are in FFT pairs).
+// The yardstick on its own: one fftPair. A shared host's speed drifts; a pair's time divided by
+// this one is a figure that does not (doc/performance.md's targets are in FFT pairs).
 void BM_Reference_FftPair(benchmark::State& state) {
   cv::Mat2f buffer;
   inputs().context->fft().inPlaceInput(buffer);

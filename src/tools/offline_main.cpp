@@ -198,9 +198,9 @@ int main(int argc, char** argv) {
       }
     }
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
-    // one registers the previous frame. Two frames queued (A/B on the authors' circle: 2.07 s
-    // vs 2.19 s with one; a second reader thread gained nothing more and cost 13 MB); each
-    // frame queued costs the 3 MB of its spectra.
+    // one registers the previous frame. Two frames queued let the reader run ahead over a slow
+    // frame (one was slower; a second reader thread gained nothing more and cost memory, see
+    // doc/performance.md); each frame queued costs the memory of its spectra.
     if (!options.quiet) {
       const std::string notice = oefmt::fftPlanningNotice(config.registration);
       if (!notice.empty()) std::fprintf(stderr, "oefmt_offline: %s\n", notice.c_str());

@@ -198,15 +198,15 @@ Command parse(int argc, char** argv) {
     } else if (arg == "--texture-size") {
       f.texture_size = args.integer(arg);
     } else if (arg == "--texture") {
-      const std::string spec = args.value(arg);
-      const auto equals = spec.find('=');
+      const std::string text = args.value(arg);
+      const auto equals = text.find('=');
       char* end = nullptr;
-      const long layer = equals == std::string::npos ? -1 : std::strtol(spec.c_str(), &end, 10);
-      if (layer < 0 || layer > 16 || end != spec.c_str() + equals || equals + 1 >= spec.size()) {
+      const long layer = equals == std::string::npos ? -1 : std::strtol(text.c_str(), &end, 10);
+      if (layer < 0 || layer > 16 || end != text.c_str() + equals || equals + 1 >= text.size()) {
         throw oefmt::InputError("--texture needs LAYER=FILE with LAYER 0 (ground), 1, 2, ...");
       }
       if (f.texture_files.size() <= static_cast<std::size_t>(layer)) f.texture_files.resize(layer + 1);
-      f.texture_files[layer] = spec.substr(equals + 1);
+      f.texture_files[layer] = text.substr(equals + 1);
     } else if (arg == "--texture-style") {
       f.texture_styles.clear();
       std::stringstream list(args.value(arg));

@@ -87,16 +87,15 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   return run;
 }
 
-// Registers "as well as" the pinhole flight. The margins come from measurements: undistorting
-// costs the frames some sharpness (resampling; a barrel lens also has fewer pixels for the
-// periphery), about a Gaussian blur of 0.5 px, and on this multi-depth scene that is enough to
-// tip an occasional marginal pair to another layer's peak (a pinhole pair blurred by 0.6 px does
-// the same). Over 13 flights of 100-300 frames (circles, figure-8s, climbing lines, 7 scenes) the
-// undistorted flights' mean error was 0.3 x .. 1.6 x the pinhole flights' where neither lost
-// track (2.6 x and 5.4 x on two figure-8s where the undistorted one lost track once: a restart
-// takes a new scale), their heading steps never off by more than 1.4 deg (pinhole: 1.6 deg). On this
-// piece: 0.14 m against 0.04 m, drift 0.85 % against 0.27 %, worst heading step 1.0 deg against
-// 0.3 deg. The distorted frames taken as they are: metres of error, drift of tens of percent.
+// Registers "as well as" the pinhole flight. The margins allow for what undistorting costs: the
+// frames lose some sharpness (resampling; a barrel lens also has fewer pixels for the
+// periphery), about a Gaussian blur of half a pixel, and on this multi-depth scene that is
+// enough to tip an occasional marginal pair to another layer's peak (a pinhole pair blurred as
+// much does the same). So the undistorted flight's error may be a small multiple of the pinhole
+// flight's, as it was over flights of several tracks and scenes where neither lost track (a
+// flight that loses track once restarts with a new scale and can be further off), and its
+// heading steps stay within the threshold. The distorted frames taken as they are fail by far:
+// metres of error, drift of tens of percent.
 ::testing::AssertionResult registersAsWell(const FlightRun& run, const FlightRun& pinhole) {
   const double ate = run.result.ate.mean, pinhole_ate = pinhole.result.ate.mean;
   const double drift = run.result.drift_percent, pinhole_drift = pinhole.result.drift_percent;

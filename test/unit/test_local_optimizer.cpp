@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The three-frame local optimizer (spec section 4 FIX, section 8 items 10 and 11).
+// The three-frame local optimizer (doc/method.md, The local optimizer): the loop closes, outliers
+// are recovered from it, degenerate inputs fall back.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Pattern matching of energy vectors (spec 2.8 and section 8 items 7, 8 and 9).
+// Pattern matching of energy vectors (doc/method.md, Pattern matching): identity, known
+// stretches and shifts, swapped inputs, rendered pairs.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -161,7 +162,7 @@ TEST(EnergyPeaks, ListsTheLayersHighestFirst) {
   EXPECT_TRUE(energyPeaks({1.0f, 0.5f}, 0.05).empty());
 }
 
-// Spec 8.9 on rendered images: two planes moving 10 and 20 px, then 15 and 30 px.
+// Rendered images: two planes moving 10 and 20 px, then 15 and 30 px.
 TEST(StretchMatch, RenderedTwoPlanePairsAtOneAndAHalfTimesTheSpeed) {
   const cv::Mat1f ground = sim::proceduralTexture({2048, 2048}, 11, sim::TextureStyle::kCells, 40);
   const cv::Mat1f roofs = sim::proceduralTexture({2048, 2048}, 12, sim::TextureStyle::kCells, 40);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Pose accumulation (spec section 5 FIX): signs, scale, yaw and covariance.
+// Pose accumulation (doc/method.md, Pose integration): signs, scale, yaw and covariance.
 #include <gtest/gtest.h>
 
 #include <algorithm>

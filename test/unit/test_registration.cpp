@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Invariants of the pair registration (algorithm spec section 8).
+// Invariants of the pair registration (doc/method.md, What the unit tests check).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Constants of the spectral tables (algorithm spec section 8, item 6) and the FFT wrapper.
+// Constants of the spectral tables (doc/method.md, The frame's spectra) and the FFT wrapper.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -11,7 +11,7 @@
 
 namespace oefmt {
 
-/// Which method turns frames into motion (the paper's comparison).
+/// Which method turns frames into motion (doc/method.md, Comparison modes).
 enum class EstimatorMode {
   kOefmt,  ///< o-eFMT: energy vectors, three-frame window, pattern matching, local optimizer
   kEfmt,   ///< original eFMT: multi-zoom translation profiles, consecutive pairs, PMT scale chain
@@ -21,7 +21,7 @@ const char* toString(EstimatorMode mode);
 /// "oefmt", "efmt" or "fmt"; throws InputError otherwise.
 EstimatorMode parseEstimatorMode(const std::string& text);
 
-/// Pattern matching of energy vectors (spec 2.8).
+/// Pattern matching of energy vectors (doc/method.md, Pattern matching).
 struct MatchingConfig {
   int stretch_steps = 100;            ///< PMT candidates exp(m key / 1000), m = -steps..steps
   double stretch_key_12 = 16.0;       ///< candidate spacing of PMT 0-1 vs 1-2 [per mille of ln]
@@ -90,7 +90,7 @@ struct UncertaintyConfig {
   void validate() const;
 };
 
-/// The original eFMT's multi-zoom translation (spec 2.9b).
+/// The original eFMT's multi-zoom translation (doc/method.md, Comparison modes).
 struct EfmtConfig {
   int zoom_samples = 5;          ///< zooms sampled between the least and most significant
   double zoom_threshold = 0.2;   ///< significant: zoom energy above this fraction of its peak

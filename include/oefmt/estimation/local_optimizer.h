@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The three-frame local optimizer (spec section 4, FIXed): pairs 1-2 and 0-2 refined together so
-// that the loop 0-1, 1-2, 0-2 closes, each measurement weighted by its sigma.
+// The three-frame local optimizer (doc/method.md, The local optimizer): pairs 1-2 and 0-2
+// refined together so that the loop 0-1, 1-2, 0-2 closes, each measurement weighted by its sigma.
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The original eFMT's multi-zoom translation estimate (spec 2.9b), for the `efmt` comparison mode.
+// The original eFMT's multi-zoom translation estimate, for the `efmt` comparison mode
+// (doc/method.md, Comparison modes).
 #pragma once
 
 #include <memory>

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// 4-DOF poses of the camera (x, y, z, yaw) accumulated from pair motions (spec section 5, FIX).
+// 4-DOF poses of the camera (x, y, z, yaw) accumulated from pair motions (doc/method.md,
+// Pose integration).
 #pragma once
 
 #include <array>
@@ -39,7 +40,7 @@ std::array<double, 36> covariance6x6(const Pose4& pose, double unobserved_varian
 /// Unit quaternion (qx, qy, qz, qw) of a rotation by yaw about z.
 std::array<double, 4> yawQuaternion(double yaw);
 
-/// Accumulates pair motions into poses (spec 5, FIX): with psi the heading in the first image's
+/// Accumulates pair motions into poses: with psi the heading in the first image's
 /// axes (psi = -yaw) and Z the altitude above the reference plane,
 ///   psi_k = wrap(psi_{k-1} + theta),  Z_k = Z_{k-1} / s,
 ///   step  = -(Z_k / fx) R(psi_k) d   in first-image axes (y down): the camera moves opposite to

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Image file decoding for datasets and compressed image messages. PNG is what simulators and
-// bag recorders write, and OpenCV's libpng + zlib path spends ~10 ms on one 512x512 RGB frame
-// here (more than the registration): common PNGs get a fast path (libdeflate inflate, tight
-// unfilter loops, ~4 ms), everything else goes to cv::imdecode. OpenCV's imgcodecs is not linked:
-// it is loaded on first use (liboefmt_image_codecs.so, beside liboefmt_core.so), as linking it
-// costs every process ~0.13 s of start-up and ~40 MB for libraries the PNG path never needs.
+// bag recorders write, and OpenCV's libpng + zlib path takes longer on a frame than the
+// registration: common PNGs get a fast path (libdeflate inflate, tight unfilter loops),
+// everything else goes to cv::imdecode. OpenCV's imgcodecs is not linked: it is loaded on first
+// use (liboefmt_image_codecs.so, beside liboefmt_core.so), as linking it costs every process
+// start-up time and memory for libraries the PNG path never needs (doc/performance.md).
 #pragma once
 
 #include <cstddef>

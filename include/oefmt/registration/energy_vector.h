@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Gaussian-fused energy-vector extraction from a correlation surface (spec section 2.4).
+// Gaussian-fused energy-vector extraction from a correlation surface (doc/method.md,
+// Energy vectors).
 #pragma once
 
 #include <vector>
@@ -39,7 +40,7 @@ EnergyVector extractEnergyVector(const cv::Mat1f& surface, const SurfacePeak& pe
                                  const EnergyVectorOptions& options);
 
 /// Width of a Gaussian through samples e[centre + o], o in [-radius, radius], from pairs of samples
-/// against the sample nearest the centre (spec 2.4 step 6), + 0.01. Returns `radius` when no pair
+/// against the sample nearest the centre, + 0.01. Returns `radius` when no pair
 /// is usable. `centre` is fractional; indices wrap when cyclic, else are clipped.
 double gaussianWidth(const float* e, int n, double centre, int radius, bool cyclic);
 

@@ -13,9 +13,9 @@ namespace oefmt {
 using Complex = std::complex<float>;
 
 /// How long FFTW may search for a fast plan when an Fft2d is made (once per size and machine:
-/// measured plans are kept as wisdom, see defaultFftWisdomPath). At N = 512 on the project's
-/// 2-core host: kMeasure plans in about 1 s, kPatient in about 9 s, and kPatient's plans made a
-/// forward + inverse pair 17-22 % faster and a pair registration 9-12 % faster (paired A/B).
+/// measured plans are kept as wisdom, see defaultFftWisdomPath). kPatient plans take several
+/// times as long as kMeasure's to make and ran faster (doc/performance.md), which pays off
+/// from the first run on, as the wisdom keeps them.
 enum class FftPlanning { kEstimate, kMeasure, kPatient };
 /// "estimate", "measure" or "patient" (the configuration's spelling).
 const char* toString(FftPlanning planning);
@@ -39,10 +39,9 @@ class Fft2d {
   /// image = IFFT(spectrum) * size^2 (unnormalised). spectrum is overwritten (FFTW c2r).
   void inverse(cv::Mat2f& spectrum, cv::Mat1f& image) const;
 
-  /// In-place transforms (FFTW's out-of-place 2-D real plans copy through a buffer; in place,
-  /// the whole offline run was 9 % faster here). A size x (size/2 + 1) complex buffer holds the
-  /// spectrum; its realView() (size x size floats, rows padded to the buffer's stride) holds the
-  /// image.
+  /// In-place transforms (FFTW's out-of-place 2-D real plans copy through a buffer; in place
+  /// they do not). A size x (size/2 + 1) complex buffer holds the spectrum; its realView()
+  /// (size x size floats, rows padded to the buffer's stride) holds the image.
   /// The image to write before forwardInPlace: `buffer` allocated if it has the wrong shape,
   /// and its realView().
   cv::Mat1f inPlaceInput(cv::Mat2f& buffer) const;
@@ -63,7 +62,7 @@ class Fft2d {
 };
 
 /// FFTW wisdom (what FFTW_MEASURE learnt about fast plans on this machine), kept between runs:
-/// measuring a 512^2 plan pair costs about a second at every start otherwise. The first measured
+/// measuring the plans would otherwise cost time at every start. The first measured
 /// Fft2d of a process imports the file at defaultFftWisdomPath(); a new measurement is exported
 /// back to it (written to a temporary file, then renamed). Failures only cost the speed-up.
 /// The file: $OEFMT_FFTW_WISDOM if set ("" or "none": no file), else

@@ -48,8 +48,8 @@ constexpr int kMinImageSide = 64;
 void requireRegistrableSize(const cv::Mat& image);
 
 /// The warning to give when frames of `image_size` are upscaled to the working size `size`
-/// (which registers worse than working at their own size: 256 px frames of the default flight,
-/// 1.09 m ATE at size 512, 0.09 m at 256), naming the size to set; empty when they are not.
+/// (which registers far worse than working at their own size: upscaling adds no detail, only
+/// interpolated texture), naming the size to set; empty when they are not.
 std::string upscalingWarning(cv::Size image_size, int size);
 
 /// Centre-crops the image to a min(W, H) square, converts it to grey float (toGreyFloat) and

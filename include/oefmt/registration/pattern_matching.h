@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Pattern matching of energy vectors (spec section 2.8, FIXed): a stretch factor between two
-// translation energy vectors (PMT) and a bin shift between two zoom energy vectors (PMS).
+// Pattern matching of energy vectors (doc/method.md, Pattern matching): a stretch factor between
+// two translation energy vectors (PMT) and a bin shift between two zoom energy vectors (PMS).
 #pragma once
 
 #include <optional>

@@ -57,8 +57,8 @@ enum class PeakShape {
   /// A peak widened by resampling (the log-polar surface): both neighbours are positive, so the
   /// larger-neighbour ratio jumps by +-0.05..0.15 bins between the two sides at whole-bin
   /// offsets. Refined by the ratio where one neighbour dominates and by the three-point centre
-  /// of mass (continuous there) where both are alike, weighted by their squared asymmetry; on
-  /// simulated flights 2-7x less rotation and 1.3-2.5x less zoom error (README "Results").
+  /// of mass (continuous there) where both are alike, weighted by their squared asymmetry, so
+  /// that the estimate does not jump at whole bins (doc/method.md, Deviations from the paper).
   kBroadened,
   /// A smooth peak (the noise-weighted translation surface: the weights act as a low-pass
   /// filter): the vertex of the parabola through the logarithms of the three values, exact for a

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Parameters of the core. Every field is documented once more in config/default.yaml and the README.
+// Parameters of the core. Every field is documented once more in config/default.yaml and
+// doc/parameters.md.
 #pragma once
 
 #include "oefmt/registration/fft.h"
 
 namespace oefmt {
 
-/// Parameters of the spectral pair registration (section 2 of the algorithm spec).
+/// Parameters of the spectral pair registration (doc/method.md, Rotation and zoom; Translation).
 struct RegistrationConfig {
   int size = 512;                         ///< working image size N (even, >= 64) [px]
   double taper_fraction = 0.12;           ///< apodization taper width as a fraction of N

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The separable apodization window (spec 2.2.1): stored as one N-vector, not an N x N image.
+// The separable apodization window (doc/method.md, The frame's spectra): stored as one N-vector,
+// not an N x N image.
 #pragma once
 
 #include <vector>
