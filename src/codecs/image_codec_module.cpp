@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // liboefmt_image_codecs.so: OpenCV's imgcodecs behind the table the core loads on first use
-// (see src/core/image_codec_module.h for why it is a plugin).
+// (see src/io/image_codec_module.h for why it is a plugin).
 #include <climits>
 
 #include <opencv2/imgcodecs.hpp>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Private to src/core: one long-lived background thread for work that runs alongside the
+// Private to src/estimation: one long-lived background thread for work that runs alongside the
 // caller (the estimator's pair 0-2). A thread per task (std::async) cost every frame a thread
 // start, a fresh stack and cold caches.
 #pragma once

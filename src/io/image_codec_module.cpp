@@ -15,7 +15,7 @@ struct Loaded {
   std::string error;  // why not, when module is null
 };
 
-// The directory of the file this code was loaded from: liboefmt_core.so, or the executable a
+// The directory of the file this code was loaded from: liboefmt_io.so, or the executable a
 // static core is linked into. The plugin is built and installed beside it.
 std::string ownDirectory() {
   Dl_info info{};

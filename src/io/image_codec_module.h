@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Private to src/core and src/codecs: OpenCV's imgcodecs, loaded on first use. Linking it costs
+// Private to src/io and src/codecs: OpenCV's imgcodecs, loaded on first use. Linking it costs
 // every process start-up time and memory (it pulls in GDAL, HDF5, Poppler, ... about 150
 // libraries) although the common PNGs never need it (decodePngFast). So the core reaches it
 // through liboefmt_image_codecs.so (src/codecs), a plugin it dlopen()s the first time an image

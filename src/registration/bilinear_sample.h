@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Private to src/core: the scalar bilinear sample of the line sampler, shared by its portable
+// Private to src/registration: the scalar bilinear sample of the line sampler, shared by its portable
 // and AVX2 kernels. `static` on purpose: each translation unit keeps its own copy, so
 // the copy compiled with -mavx2 can never be the one the linker picks for portable code.
 #pragma once

@@ -7,7 +7,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <mutex>
 #include <string>
@@ -30,6 +29,16 @@ void requireAligned(const void* data, const char* what) {
   if (fftwf_alignment_of(reinterpret_cast<float*>(const_cast<void*>(data))) != 0) {
     throw std::logic_error(std::string("Fft2d: ") + what + " is not SIMD-aligned");
   }
+}
+
+// The wisdom file (setFftWisdomFile) and whether it has been read; guarded by the planner mutex.
+std::string& wisdomFile() {
+  static std::string path;
+  return path;
+}
+bool& wisdomImported() {
+  static bool imported = false;
+  return imported;
 }
 
 // Measuring plans for which the wisdom had no answer takes this long at least; quicker
@@ -70,23 +79,15 @@ const char* toString(FftPlanning planning) {
   return "unknown";
 }
 
-std::string defaultFftWisdomPath() {
-  if (const char* explicit_path = std::getenv("OEFMT_FFTW_WISDOM")) {
-    const std::string path(explicit_path);
-    return path == "none" ? std::string() : path;
-  }
-  std::filesystem::path cache;
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && xdg[0] == '/') {
-    cache = xdg;
-  } else if (const char* home = std::getenv("HOME"); home != nullptr && home[0] == '/') {
-    cache = std::filesystem::path(home) / ".cache";
-  } else {
-    return std::string();
-  }
-  // Wisdom describes one machine: keyed by host for home folders shared between machines.
-  char host[256] = {};
-  if (::gethostname(host, sizeof(host) - 1) != 0 || host[0] == '\0') std::snprintf(host, sizeof(host), "unknown");
-  return (cache / "oefmt" / (std::string("fftwf-wisdom-") + host)).string();
+void setFftWisdomFile(const std::string& path) {
+  std::lock_guard<std::mutex> lock(plannerMutex());
+  wisdomFile() = path;
+  wisdomImported() = false;
+}
+
+std::string fftWisdomFile() {
+  std::lock_guard<std::mutex> lock(plannerMutex());
+  return wisdomFile();
 }
 
 namespace {
@@ -100,15 +101,13 @@ unsigned plannerFlags(FftPlanning planning) {
   return FFTW_MEASURE;
 }
 
-// The first measured Fft2d (or fftPlansKnown) of a process reads the wisdom file once; later
+// The first measured Fft2d (or fftPlansKnown) after the wisdom file is set reads it once; later
 // ones find its plans in memory. The caller holds the planner mutex.
 void importWisdomOnceLocked(FftPlanning planning) {
-  static bool imported = false;
-  if (imported || planning == FftPlanning::kEstimate) return;
-  const std::string wisdom = defaultFftWisdomPath();
-  if (wisdom.empty()) return;
-  importWisdomLocked(wisdom);
-  imported = true;
+  if (wisdomImported() || planning == FftPlanning::kEstimate) return;
+  if (wisdomFile().empty()) return;
+  importWisdomLocked(wisdomFile());
+  wisdomImported() = true;
 }
 
 // Plans the r2c and c2r transforms between `real` and `complex` (the same memory: in place) and
@@ -116,7 +115,7 @@ void importWisdomOnceLocked(FftPlanning planning) {
 void planPairLocked(int size, float* real, fftwf_complex* complex, FftPlanning planning,
                     fftwf_plan& forward, fftwf_plan& inverse) {
   const unsigned flags = plannerFlags(planning);
-  const std::string wisdom = planning == FftPlanning::kEstimate ? std::string() : defaultFftWisdomPath();
+  const std::string wisdom = planning == FftPlanning::kEstimate ? std::string() : wisdomFile();
   const auto start = std::chrono::steady_clock::now();
   forward = fftwf_plan_dft_r2c_2d(size, size, real, complex, flags);
   inverse = fftwf_plan_dft_c2r_2d(size, size, complex, real, flags);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Private to src/core: the loops that have a CPU-specific version. The *Avx2 kernels (the
+// Private to src/registration: the loops that have a CPU-specific version. The *Avx2 kernels (the
 // *_avx2.cpp files, compiled with -mavx2 -mfma on x86-64) run only when cpuRunsAvx2Kernels()
 // is true; elsewhere those files hold stubs that are never called.
 #pragma once

@@ -165,10 +165,10 @@ float noisePower(const cv::Mat2f& spectrum) {
 std::string fftPlanningNotice(const RegistrationConfig& config) {
   if (fftPlansKnown(config.size, config.fft_planning)) return std::string();
   const std::string n = std::to_string(config.size);
-  const std::string wisdom = defaultFftWisdomPath();
+  const std::string wisdom = fftWisdomFile();
   return "measuring FFTW plans for " + n + "x" + n + " transforms (registration.fft_planning: " +
          toString(config.fft_planning) + "; at N = 512 about 1 s with measure, 10 s with patient)" +
-         (wisdom.empty() ? std::string(", at every start: OEFMT_FFTW_WISDOM=none keeps no wisdom")
+         (wisdom.empty() ? std::string(", at every start: no wisdom file is kept")
                          : ", once: they are kept in " + wisdom);
 }
 

@@ -21,6 +21,7 @@
 #include "oefmt/ros/parameter_yaml.h"
 #include "oefmt/estimation/pose.h"
 #include "oefmt/io/undistortion.h"
+#include "oefmt/io/fft_wisdom.h"
 
 namespace oefmt {
 namespace {
@@ -54,6 +55,7 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
       name_(name),
       image_transport_(nh),
       tf_listener_(tf_buffer_) {
+  useDefaultFftWisdom();
   loadParameters();
   estimator_config_ = loadEstimatorConfig();
   stamp_guard_ = StampGuard(parameters_.time_jump_tolerance);

@@ -25,6 +25,7 @@
 #include "oefmt/registration/warp.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
+#include "oefmt/io/fft_wisdom.h"
 
 namespace {
 
@@ -351,6 +352,7 @@ BENCHMARK(BM_Stage_PeakAndEnergyVector)->Unit(benchmark::kMicrosecond);
 }  // namespace
 
 int main(int argc, char** argv) {
+  oefmt::useDefaultFftWisdom();
   int threads = 1;
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::strcmp(argv[i], "--threads") == 0) {

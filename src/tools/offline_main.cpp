@@ -27,6 +27,7 @@
 #include "oefmt/registration/spectra.h"
 #include "oefmt/io/tum.h"
 #include "oefmt/io/undistortion.h"
+#include "oefmt/io/fft_wisdom.h"
 
 namespace {
 
@@ -144,6 +145,7 @@ double percentile(std::vector<double> values, double q) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  oefmt::useDefaultFftWisdom();
   const Options options = parseArguments(argc, argv);
   std::ofstream trajectory, diagnostics;
   long frames = 0, not_tracked = 0, restarts = 0, fallbacks = 0;

@@ -13,6 +13,7 @@
 #include "oefmt/registration/registration.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
+#include "oefmt/io/fft_wisdom.h"
 
 namespace {
 
@@ -34,6 +35,7 @@ int argmaxOf(const std::vector<float>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  oefmt::useDefaultFftWisdom();
   int size = 512;
   oefmt::RegistrationMethod method = oefmt::RegistrationMethod::kEnergyVectors;
   std::vector<std::string> paths;

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <string>
 
+#include "oefmt/io/fft_wisdom.h"
+
 int main(int argc, char** argv) {
   // Tests plan FFTs in their own wisdom file, never in the user's (~/.cache/oefmt): plans
   // measured while the tests load the machine (and re-measured after a test forgets the
@@ -19,6 +21,7 @@ int main(int argc, char** argv) {
               : (temporary / ("oefmt-tests-fftwf-wisdom-" + std::to_string(::getuid()))).string();
     setenv("OEFMT_FFTW_WISDOM", wisdom.c_str(), 1);
   }
+  oefmt::useDefaultFftWisdom();
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }

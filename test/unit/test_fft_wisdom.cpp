@@ -9,6 +9,7 @@
 #include <string>
 
 #include "support/temp_dir.h"
+#include "oefmt/io/fft_wisdom.h"
 #include "oefmt/registration/fft.h"
 
 namespace oefmt {
@@ -42,7 +43,7 @@ class ScopedEnvironment {
 // do not measure their plans again (seconds each at N = 512 with the default patient planning).
 class FftWisdom : public ::testing::Test {
  protected:
-  void TearDown() override { importFftWisdom(defaultFftWisdomPath()); }
+  void TearDown() override { importFftWisdom(fftWisdomFile()); }
 };
 
 // forward then inverse gives the input times N^2 when the plans are sound.
@@ -102,6 +103,22 @@ TEST_F(FftWisdom, KnowsWhenPlansStillNeedMeasuring) {
   EXPECT_TRUE(fftPlansKnown(kN, FftPlanning::kPatient));
   EXPECT_FALSE(fftPlansKnown(kN + 2, FftPlanning::kPatient)) << "wisdom is per size";
   EXPECT_FALSE(fftPlansKnown(57, FftPlanning::kMeasure)) << "odd sizes are refused";
+}
+
+// A newly set wisdom file is read before the next plan: a program chooses its file at start.
+TEST_F(FftWisdom, ANewWisdomFileIsReadBeforeTheNextPlan) {
+  constexpr int kN = 62;  // a size no other test plans
+  test::TempDir dir;
+  const std::string file = dir / "wisdom";
+  expectRoundTrip(kN, FftPlanning::kMeasure);
+  ASSERT_TRUE(exportFftWisdom(file));
+  const std::string before = fftWisdomFile();
+  forgetAllWisdom();
+  EXPECT_FALSE(fftPlansKnown(kN, FftPlanning::kMeasure));
+  setFftWisdomFile(file);
+  EXPECT_EQ(fftWisdomFile(), file);
+  EXPECT_TRUE(fftPlansKnown(kN, FftPlanning::kMeasure)) << "the new file was not read";
+  setFftWisdomFile(before);
 }
 
 TEST_F(FftWisdom, DefaultPathFollowsTheEnvironment) {

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The visual-odometry estimator: frames in, 4-DOF poses out (o-eFMT three-frame estimator, or the
-// efmt / fmt comparison methods). A plain object: no threads, no I/O.
+// efmt / fmt comparison methods). No file or environment access: images come in as pixels, the
+// configuration as a struct. With parallel_registrations, one frame's two registrations run on a
+// worker thread the estimator owns; process() still returns only when the frame is done, so
+// callers see a synchronous object (one caller at a time).
 #pragma once
 
 #include <cstddef>

@@ -3,7 +3,7 @@
 // bag recorders write, and OpenCV's libpng + zlib path takes longer on a frame than the
 // registration: common PNGs get a fast path (libdeflate inflate, tight unfilter loops),
 // everything else goes to cv::imdecode. OpenCV's imgcodecs is not linked: it is loaded on first
-// use (liboefmt_image_codecs.so, beside liboefmt_core.so), as linking it costs every process
+// use (liboefmt_image_codecs.so, beside liboefmt_io.so), as linking it costs every process
 // start-up time and memory for libraries the PNG path never needs (doc/performance.md).
 #pragma once
 

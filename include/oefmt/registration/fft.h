@@ -13,7 +13,7 @@ namespace oefmt {
 using Complex = std::complex<float>;
 
 /// How long FFTW may search for a fast plan when an Fft2d is made (once per size and machine:
-/// measured plans are kept as wisdom, see defaultFftWisdomPath). kPatient plans take several
+/// measured plans are kept as wisdom, see setFftWisdomFile). kPatient plans take several
 /// times as long as kMeasure's to make and ran faster (doc/performance.md), which pays off
 /// from the first run on, as the wisdom keeps them.
 enum class FftPlanning { kEstimate, kMeasure, kPatient };
@@ -62,18 +62,19 @@ class Fft2d {
 };
 
 /// FFTW wisdom (what FFTW_MEASURE learnt about fast plans on this machine), kept between runs:
-/// measuring the plans would otherwise cost time at every start. The first measured
-/// Fft2d of a process imports the file at defaultFftWisdomPath(); a new measurement is exported
-/// back to it (written to a temporary file, then renamed). Failures only cost the speed-up.
-/// The file: $OEFMT_FFTW_WISDOM if set ("" or "none": no file), else
-/// $XDG_CACHE_HOME/oefmt/fftwf-wisdom-<host> (default cache: ~/.cache).
-std::string defaultFftWisdomPath();
+/// measuring the plans would otherwise cost time at every start. Once a file is set, the first
+/// measured Fft2d imports it; a new measurement is exported back to it (written to a temporary
+/// file, then renamed). Failures only cost the speed-up. The library keeps no file unless told
+/// ("", the default): the tools and the node set the user's cache file (oefmt/io/fft_wisdom.h).
+void setFftWisdomFile(const std::string& path);
+/// The file set by setFftWisdomFile ("" = none).
+std::string fftWisdomFile();
 /// Replaces the process's FFTW wisdom with the file's; false (wisdom forgotten) if unreadable.
 bool importFftWisdom(const std::string& path);
 /// Writes the process's FFTW wisdom to `path` atomically; false on failure.
 bool exportFftWisdom(const std::string& path);
-/// Whether an Fft2d(size, planning) would find its plans in the wisdom (importing the file at
-/// defaultFftWisdomPath() first, as Fft2d does): false means it is about to measure them, which
+/// Whether an Fft2d(size, planning) would find its plans in the wisdom (importing the wisdom
+/// file first, as Fft2d does): false means it is about to measure them, which
 /// a caller may want to announce (seconds at N = 512 with kPatient). kEstimate: always true.
 bool fftPlansKnown(int size, FftPlanning planning);
 
