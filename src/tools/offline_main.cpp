@@ -22,7 +22,6 @@
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/estimation/estimator_config.h"
 #include "oefmt/registration/image_prep.h"
-#include "oefmt/ros/bag_io.h"
 #include "progress.h"
 #include "oefmt/registration/spectra.h"
 #include "oefmt/io/tum.h"
