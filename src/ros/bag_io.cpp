@@ -4,64 +4,32 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
+#include <limits>
 #include <map>
 
-#include <opencv2/imgproc.hpp>
+#include <boost/make_shared.hpp>
+#include <cv_bridge/cv_bridge.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/distortion_models.h>
+#include <sensor_msgs/image_encodings.h>
 
 #include "oefmt/error.h"
-#include "oefmt/io/image_decoding.h"
 #include "oefmt/io/image_encoding.h"
 
 namespace oefmt {
 namespace {
 
-struct EncodingInfo {
-  int type;
-  bool swap_red_blue;
-  int demosaic = -1;  ///< cv::COLOR_Bayer*2BGR code for Bayer patterns
-};
+namespace enc = sensor_msgs::image_encodings;
 
-const std::map<std::string, EncodingInfo>& encodingTable() {
-  static const std::map<std::string, EncodingInfo> table = {
-      {"mono8", {CV_8UC1, false}},   {"8UC1", {CV_8UC1, false}},    {"mono16", {CV_16UC1, false}},
-      {"16UC1", {CV_16UC1, false}},  {"bgr8", {CV_8UC3, false}},    {"rgb8", {CV_8UC3, true}},
-      {"8UC3", {CV_8UC3, false}},    {"bgra8", {CV_8UC4, false}},   {"rgba8", {CV_8UC4, true}},
-      {"8UC4", {CV_8UC4, false}},    {"bgr16", {CV_16UC3, false}},  {"rgb16", {CV_16UC3, true}},
-      {"16UC3", {CV_16UC3, false}},  {"bgra16", {CV_16UC4, false}}, {"rgba16", {CV_16UC4, true}},
-      {"16UC4", {CV_16UC4, false}},  {"32FC1", {CV_32FC1, false}},  {"64FC1", {CV_64FC1, false}},
-      // Raw Bayer mosaics, demosaiced to BGR. OpenCV names a pattern by its second row's
-      // start, as cv_bridge maps them: rggb -> BayerBG, bggr -> BayerRG, gbrg -> BayerGR, grbg -> BayerGB.
-      {"bayer_rggb8", {CV_8UC1, false, cv::COLOR_BayerBG2BGR}},
-      {"bayer_bggr8", {CV_8UC1, false, cv::COLOR_BayerRG2BGR}},
-      {"bayer_gbrg8", {CV_8UC1, false, cv::COLOR_BayerGR2BGR}},
-      {"bayer_grbg8", {CV_8UC1, false, cv::COLOR_BayerGB2BGR}},
-      {"bayer_rggb16", {CV_16UC1, false, cv::COLOR_BayerBG2BGR}},
-      {"bayer_bggr16", {CV_16UC1, false, cv::COLOR_BayerRG2BGR}},
-      {"bayer_gbrg16", {CV_16UC1, false, cv::COLOR_BayerGR2BGR}},
-      {"bayer_grbg16", {CV_16UC1, false, cv::COLOR_BayerGB2BGR}},
-  };
-  return table;
+std::string sizeText(std::uint64_t width, std::uint64_t height) {
+  return std::to_string(width) + "x" + std::to_string(height);
 }
 
-bool hostIsBigEndian() {
-  const std::uint16_t probe = 1;
-  unsigned char first = 0;
-  std::memcpy(&first, &probe, 1);
-  return first == 0;
-}
-
-void swapBytes(cv::Mat& image) {
-  const std::size_t size = image.elemSize1();
-  if (size == 1) return;
-  for (int r = 0; r < image.rows; ++r) {
-    unsigned char* p = image.ptr<unsigned char>(r);
-    const std::size_t count = static_cast<std::size_t>(image.cols) * image.channels();
-    for (std::size_t i = 0; i < count; ++i, p += size) std::reverse(p, p + size);
-  }
+// Encodings that say what their channels are (grey, colour, a Bayer mosaic, YUV): cv_bridge
+// turns them into grey. The generic ones (8UC1, 32FC1, ...) say only how they are stored.
+bool hasColourMeaning(const std::string& encoding) {
+  return enc::isMono(encoding) || enc::isColor(encoding) || enc::isBayer(encoding) || encoding == enc::YUV422;
 }
 
 std::string joined(const std::vector<std::string>& items) {
@@ -89,84 +57,99 @@ ros::Time rosTime(double stamp) {
 
 }  // namespace
 
-const std::vector<std::string>& supportedImageEncodings() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const auto& entry : encodingTable()) out.push_back(entry.first);
-    return out;
-  }();
-  return names;
-}
-
 cv::Mat imageFromMessage(const sensor_msgs::Image& message) {
-  const auto found = encodingTable().find(message.encoding);
-  if (found == encodingTable().end()) {
-    throw BagError("unsupported image encoding '" + message.encoding + "' (supported: " +
-                   joined(supportedImageEncodings()) + ")");
+  const std::string& encoding = message.encoding;
+  const std::string what = "'" + encoding + "' image of " + sizeText(message.width, message.height);
+  int type = -1;
+  try {
+    type = cv_bridge::getCvType(encoding);
+  } catch (const cv_bridge::Exception& e) {
+    throw BagError("unsupported image encoding '" + encoding + "' (" + e.what() + ")");
   }
-  const EncodingInfo info = found->second;
-  const int rows = static_cast<int>(message.height), cols = static_cast<int>(message.width);
-  if (rows <= 0 || cols <= 0) throw BagError("image message of size " + std::to_string(cols) + "x" + std::to_string(rows));
-  const std::size_t row_bytes = static_cast<std::size_t>(cols) * CV_ELEM_SIZE(info.type);
-  if (message.step < row_bytes || message.data.size() < static_cast<std::size_t>(message.step) * (rows - 1) + row_bytes) {
-    throw BagError("image message '" + message.encoding + "' " + std::to_string(cols) + "x" + std::to_string(rows) +
-                   " has step " + std::to_string(message.step) + " and " + std::to_string(message.data.size()) +
-                   " bytes: too few");
+  // cv_bridge checks the step and size too, but in 32-bit arithmetic (which can wrap) and only
+  // after it has taken the address of the first byte (of no data, too): checked here first.
+  if (message.width == 0 || message.height == 0) throw BagError(what + ": no pixels");
+  constexpr std::uint32_t kMaxSide = std::numeric_limits<int>::max();  // cv::Mat's
+  if (message.width > kMaxSide || message.height > kMaxSide) throw BagError(what + ": too large");
+  const std::uint64_t row_bytes = std::uint64_t{message.width} * CV_ELEM_SIZE(type);
+  const std::uint64_t needed = std::uint64_t{message.step} * message.height;
+  if (message.step < row_bytes || message.data.size() != needed) {
+    throw BagError(what + " has step " + std::to_string(message.step) + " and " +
+                   std::to_string(message.data.size()) + " bytes: " +
+                   (message.step < row_bytes ? "a row needs " + std::to_string(row_bytes)
+                                             : std::string(message.data.size() < needed ? "too few" : "too many") +
+                                                   " (height x step = " + std::to_string(needed) + ")"));
   }
-  cv::Mat image(rows, cols, info.type);
-  for (int r = 0; r < rows; ++r) {
-    std::memcpy(image.ptr(r), message.data.data() + static_cast<std::size_t>(r) * message.step, row_bytes);
+  if (message.step % CV_ELEM_SIZE1(type) != 0) {  // OpenCV's rows start on a whole channel value
+    throw BagError(what + " has step " + std::to_string(message.step) + ": not a multiple of its " +
+                   std::to_string(CV_ELEM_SIZE1(type)) + "-byte channel values");
   }
-  if ((message.is_bigendian != 0) != hostIsBigEndian()) swapBytes(image);
-  if (info.swap_red_blue) {
-    cv::cvtColor(image, image, image.channels() == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGRA);
+  try {
+    // The pixels as stored: shared with the message, or a copy when they had to be byte-swapped.
+    const cv_bridge::CvImageConstPtr stored = cv_bridge::toCvShare(message, nullptr);
+    cv_bridge::CvImageConstPtr pixels = stored;
+    if (stored->image.type() != type) {
+      // cv_bridge byte-swaps big-endian pixels but hands them back as 8-bit channels: the bytes
+      // are right, their type is the encoding's (a view of `stored`, alive until the copy below).
+      const cv::Mat& swapped = stored->image;
+      pixels = boost::make_shared<cv_bridge::CvImage>(
+          stored->header, encoding, cv::Mat(swapped.rows, swapped.cols, type, swapped.data, swapped.step));
+    }
+    if (hasColourMeaning(encoding)) {
+      // Grey as OpenCV's cvtColor weighs the channels (demosaiced for Bayer), at 8 or 16 bits.
+      return cv_bridge::cvtColor(pixels, enc::bitDepth(encoding) == 16 ? enc::MONO16 : enc::MONO8)->image;
+    }
+    const int depth = CV_MAT_DEPTH(type), channels = CV_MAT_CN(type);
+    if ((depth != CV_8U && depth != CV_16U && depth != CV_32F && depth != CV_64F) ||
+        (channels != 1 && channels != 3 && channels != 4)) {
+      throw BagError("unsupported image encoding '" + encoding +
+                     "': the estimator takes grey or colour encodings, or 1, 3 or 4 channels (three "
+                     "or four as BGR(A)) of 8/16-bit unsigned or float pixels");
+    }
+    return pixels->image.clone();
+  } catch (const cv_bridge::Exception& e) {
+    throw BagError(what + ": " + e.what());
+  } catch (const cv::Exception& e) {  // from OpenCV's conversion (e.err: without file and line)
+    throw BagError(what + ": " + e.err);
   }
-  if (info.demosaic >= 0) {
-    if (rows < 2 || cols < 2) throw BagError("Bayer image smaller than 2x2");
-    cv::cvtColor(image, image, info.demosaic);
-  }
-  return image;
 }
 
 cv::Mat imageFromMessage(const sensor_msgs::CompressedImage& message) {
+  const std::string what = "compressed image (format '" + message.format + "', " +
+                           std::to_string(message.data.size()) + " bytes)";
+  if (message.data.empty()) throw BagError("cannot decode " + what + ": no data");
   cv::Mat image;
-  if (!message.data.empty()) {
-    try {
-      image = decodeImage(message.data.data(), message.data.size());
-    } catch (const std::exception& e) {  // an image over the size limit, no imgcodecs plugin
-      throw BagError(std::string("compressed image: ") + e.what());
-    }
+  try {
+    // Decoded as stored (cv::imdecode, IMREAD_UNCHANGED) and made grey at its own depth:
+    // cv_bridge names every one-channel result mono8, but a 16-bit PNG keeps its 16 bits.
+    const cv_bridge::CvImagePtr decoded = cv_bridge::toCvCopy(message, enc::MONO8);
+    if (decoded) image = decoded->image;
+  } catch (const cv_bridge::Exception& e) {
+    throw BagError("cannot decode " + what + ": " + e.what());
+  } catch (const cv::Exception& e) {  // from cv::imdecode
+    throw BagError("cannot decode " + what + ": " + e.err);
   }
-  if (image.empty()) {
-    throw BagError("cannot decode compressed image (format '" + message.format + "', " +
-                   std::to_string(message.data.size()) + " bytes)");
-  }
+  if (image.empty()) throw BagError("cannot decode " + what);
   return image;
 }
 
 sensor_msgs::Image imageMessage(const cv::Mat& image, double stamp, const std::string& frame_id) {
   std::string encoding;
   switch (image.type()) {
-    case CV_8UC1: encoding = "mono8"; break;
-    case CV_16UC1: encoding = "mono16"; break;
-    case CV_8UC3: encoding = "bgr8"; break;
-    case CV_8UC4: encoding = "bgra8"; break;
-    case CV_16UC3: encoding = "bgr16"; break;
-    case CV_32FC1: encoding = "32FC1"; break;
-    case CV_64FC1: encoding = "64FC1"; break;
+    case CV_8UC1: encoding = enc::MONO8; break;
+    case CV_16UC1: encoding = enc::MONO16; break;
+    case CV_8UC3: encoding = enc::BGR8; break;
+    case CV_8UC4: encoding = enc::BGRA8; break;
+    case CV_16UC3: encoding = enc::BGR16; break;
+    case CV_32FC1: encoding = enc::TYPE_32FC1; break;
+    case CV_64FC1: encoding = enc::TYPE_64FC1; break;
     default: throw BagError("cannot store an image of type " + cv::typeToString(image.type()) + " in a bag");
   }
+  std_msgs::Header header;
+  header.stamp = rosTime(stamp);
+  header.frame_id = frame_id;
   sensor_msgs::Image message;
-  message.header.stamp = rosTime(stamp);
-  message.header.frame_id = frame_id;
-  message.height = static_cast<std::uint32_t>(image.rows);
-  message.width = static_cast<std::uint32_t>(image.cols);
-  message.encoding = encoding;
-  message.is_bigendian = hostIsBigEndian() ? 1 : 0;
-  const std::size_t row_bytes = static_cast<std::size_t>(image.cols) * image.elemSize();
-  message.step = static_cast<std::uint32_t>(row_bytes);
-  message.data.resize(row_bytes * image.rows);
-  for (int r = 0; r < image.rows; ++r) std::memcpy(&message.data[r * row_bytes], image.ptr(r), row_bytes);
+  cv_bridge::CvImage(header, encoding, image).toImageMsg(message);
   return message;
 }
 

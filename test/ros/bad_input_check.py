@@ -98,7 +98,7 @@ class BadInputCheck(unittest.TestCase):
             k += 1
         cls.count_before_bad = len(cls.odometry)
         cls.stamp += 0.2
-        cls.send(np.zeros((256, 256, 2), np.uint8), "yuv422")           # unsupported encoding
+        cls.send(np.zeros((256, 256, 2), np.uint8), "8UC2")             # unsupported encoding
         for _ in range(3):                                              # lens cap: black frames
             cls.stamp += 0.2
             cls.send(np.zeros((256, 256), np.uint8), "mono8")

@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <rosbag/bag.h>
 
@@ -106,7 +107,7 @@ void writeImageBag(const std::string& path, const std::string& encoding, const c
   message.height = static_cast<std::uint32_t>(pixels.rows);
   message.width = static_cast<std::uint32_t>(pixels.cols);
   message.is_bigendian = big_endian ? 1 : 0;
-  message.step = static_cast<std::uint32_t>(pixels.cols * pixels.elemSize() + 3);  // padded rows
+  message.step = static_cast<std::uint32_t>(pixels.cols * pixels.elemSize() + 8);  // padded rows
   message.data.assign(static_cast<std::size_t>(message.step) * pixels.rows, 0);
   for (int r = 0; r < pixels.rows; ++r) {
     std::memcpy(&message.data[r * message.step], pixels.ptr(r), pixels.cols * pixels.elemSize());
@@ -124,6 +125,8 @@ cv::Mat readOnlyFrame(const std::string& path) {
   return frame.image;
 }
 
+// What the estimator gets of each encoding: grey as OpenCV weighs colours (at 8 or 16 bits), or the
+// pixels as stored for generic encodings.
 TEST(BagIo, DecodesEveryCommonEncoding) {
   TempDir dir;
   cv::Mat3b bgr(4, 5);
@@ -137,6 +140,10 @@ TEST(BagIo, DecodesEveryCommonEncoding) {
   cv::cvtColor(bgr, mono8, cv::COLOR_BGR2GRAY);
   cv::Mat1w mono16;
   mono8.convertTo(mono16, CV_16U, 257.0);
+  cv::Mat3w bgr16;
+  bgr.convertTo(bgr16, CV_16U, 257.0);
+  cv::Mat1w grey16;
+  cv::cvtColor(bgr16, grey16, cv::COLOR_BGR2GRAY);
   cv::Mat1f float32;
   mono8.convertTo(float32, CV_32F, 1.0 / 255.0);
 
@@ -145,9 +152,10 @@ TEST(BagIo, DecodesEveryCommonEncoding) {
     cv::Mat stored;
     cv::Mat expected;
   };
-  const Case cases[] = {{"mono8", mono8, mono8}, {"mono16", mono16, mono16}, {"bgr8", bgr, bgr},
-                        {"rgb8", rgb, bgr},      {"bgra8", bgra, bgra},      {"rgba8", rgba, bgra},
-                        {"32FC1", float32, float32}};
+  const Case cases[] = {{"mono8", mono8, mono8}, {"mono16", mono16, mono16}, {"bgr8", bgr, mono8},
+                        {"rgb8", rgb, mono8},    {"bgra8", bgra, mono8},     {"rgba8", rgba, mono8},
+                        {"bgr16", bgr16, grey16}, {"32FC1", float32, float32}, {"8UC1", mono8, mono8},
+                        {"8UC3", bgr, bgr}};
   for (const Case& c : cases) {
     const std::string path = dir / (std::string(c.encoding) + ".bag");
     writeImageBag(path, c.encoding, c.stored);
@@ -155,22 +163,32 @@ TEST(BagIo, DecodesEveryCommonEncoding) {
     ASSERT_EQ(image.type(), c.expected.type()) << c.encoding;
     EXPECT_EQ(cv::norm(image, c.expected, cv::NORM_INF), 0.0) << c.encoding;
   }
-  // Big-endian 16-bit data.
-  cv::Mat1w swapped(mono16.size());
-  for (int r = 0; r < mono16.rows; ++r) {
-    for (int col = 0; col < mono16.cols; ++col) {
-      swapped(r, col) = static_cast<std::uint16_t>((mono16(r, col) >> 8) | (mono16(r, col) << 8));
+  // Big-endian 16-bit data, grey and colour.
+  const auto swapped = [](const cv::Mat& image) {
+    cv::Mat out = image.clone();
+    for (int r = 0; r < out.rows; ++r) {
+      auto* p = out.ptr<std::uint16_t>(r);
+      for (int i = 0; i < out.cols * out.channels(); ++i) p[i] = static_cast<std::uint16_t>((p[i] >> 8) | (p[i] << 8));
     }
-  }
-  writeImageBag(dir / "big.bag", "mono16", swapped, true);
-  EXPECT_EQ(cv::norm(readOnlyFrame(dir / "big.bag"), mono16, cv::NORM_INF), 0.0);
+    return out;
+  };
+  writeImageBag(dir / "big.bag", "mono16", swapped(mono16), true);
+  cv::Mat image = readOnlyFrame(dir / "big.bag");
+  ASSERT_EQ(image.type(), CV_16UC1);
+  EXPECT_EQ(cv::norm(image, mono16, cv::NORM_INF), 0.0);
+  writeImageBag(dir / "big_bgr16.bag", "bgr16", swapped(bgr16), true);
+  image = readOnlyFrame(dir / "big_bgr16.bag");
+  ASSERT_EQ(image.type(), CV_16UC1);
+  EXPECT_EQ(cv::norm(image, grey16, cv::NORM_INF), 0.0);
 }
 
-// A uniform colour seen through each Bayer pattern must come back as that colour (a wrong
-// pattern mapping swaps red and blue or mixes in green).
+// A uniform colour seen through each Bayer pattern must come back as that colour's grey (a wrong
+// pattern mapping swaps red and blue, or mixes in green, and changes the grey).
 TEST(BagIo, DemosaicsBayerPatterns) {
   TempDir dir;
   const int blue = 30, green = 120, red = 200;
+  cv::Mat1b grey;
+  cv::cvtColor(cv::Mat3b(1, 1, cv::Vec3b(blue, green, red)), grey, cv::COLOR_BGR2GRAY);
   // The colour at (row, col) of each pattern: its name lists row 0 (two pixels), then row 1.
   const std::map<std::string, std::string> patterns = {
       {"bayer_rggb8", "rggb"}, {"bayer_bggr8", "bggr"}, {"bayer_gbrg8", "gbrg"}, {"bayer_grbg8", "grbg"}};
@@ -185,12 +203,42 @@ TEST(BagIo, DemosaicsBayerPatterns) {
     const std::string path = dir / (encoding + ".bag");
     writeImageBag(path, encoding, mosaic);
     const cv::Mat image = readOnlyFrame(path);
-    ASSERT_EQ(image.type(), CV_8UC3) << encoding;
-    const cv::Vec3b centre = image.at<cv::Vec3b>(4, 4);
-    EXPECT_NEAR(centre[0], blue, 1) << encoding;
-    EXPECT_NEAR(centre[1], green, 1) << encoding;
-    EXPECT_NEAR(centre[2], red, 1) << encoding;
+    ASSERT_EQ(image.type(), CV_8UC1) << encoding;
+    EXPECT_NEAR(image.at<unsigned char>(4, 4), grey(0, 0), 2) << encoding;
   }
+}
+
+// Compressed images become grey at their own depth, as cv::imdecode and cvtColor make them.
+TEST(BagIo, CompressedImagesBecomeGrey) {
+  cv::Mat3b bgr(24, 32);
+  cv::randu(bgr, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::Mat1b grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  cv::Mat3w bgr16;
+  bgr.convertTo(bgr16, CV_16U, 257.0);
+  cv::Mat1w grey16;
+  cv::cvtColor(bgr16, grey16, cv::COLOR_BGR2GRAY);
+  const auto compressed = [](const std::string& format, const cv::Mat& image) {
+    sensor_msgs::CompressedImage message;
+    message.format = format;
+    EXPECT_TRUE(cv::imencode("." + format, image, message.data));
+    return message;
+  };
+  struct Case {
+    std::string format;
+    cv::Mat stored, expected;
+  };
+  for (const Case& c : {Case{"png", grey, grey}, Case{"png", bgr, grey}, Case{"png", grey16, grey16},
+                        Case{"png", bgr16, grey16}}) {
+    const cv::Mat image = imageFromMessage(compressed(c.format, c.stored));
+    ASSERT_EQ(image.type(), c.expected.type()) << cv::typeToString(c.stored.type());
+    EXPECT_EQ(cv::norm(image, c.expected, cv::NORM_INF), 0.0) << cv::typeToString(c.stored.type());
+  }
+  // JPEG: the grey of what cv::imdecode makes of the file.
+  const sensor_msgs::CompressedImage jpeg = compressed("jpg", bgr);
+  cv::Mat1b expected;
+  cv::cvtColor(cv::imdecode(jpeg.data, cv::IMREAD_UNCHANGED), expected, cv::COLOR_BGR2GRAY);
+  EXPECT_EQ(cv::norm(imageFromMessage(jpeg), expected, cv::NORM_INF), 0.0);
 }
 
 void expectBagError(const std::function<void()>& action, const std::string& fragment) {
@@ -204,13 +252,14 @@ void expectBagError(const std::function<void()>& action, const std::string& frag
 
 TEST(BagIo, ClearErrors) {
   TempDir dir;
-  writeImageBag(dir / "yuv.bag", "yuv422", cv::Mat1w(4, 4, static_cast<std::uint16_t>(0)));
-  BagImageReader reader(dir / "yuv.bag");
+  writeImageBag(dir / "nv21.bag", "nv21", cv::Mat1b(6, 4, static_cast<unsigned char>(0)));
+  BagImageReader reader(dir / "nv21.bag");
   BagFrame frame;
-  expectBagError([&] { reader.next(frame); }, "unsupported image encoding 'yuv422'");
+  expectBagError([&] { reader.next(frame); }, "unsupported image encoding 'nv21'");
+  expectBagError([&] { reader.next(frame); }, "topic '/cam/image' of bag");
 
-  expectBagError([&] { BagImageReader(dir / "yuv.bag", "/missing"); }, "has no topic '/missing'");
-  expectBagError([&] { BagImageReader(dir / "yuv.bag", "", "/info"); }, "no CameraInfo topic '/info'");
+  expectBagError([&] { BagImageReader(dir / "nv21.bag", "/missing"); }, "has no topic '/missing'");
+  expectBagError([&] { BagImageReader(dir / "nv21.bag", "", "/info"); }, "no CameraInfo topic '/info'");
   std::ofstream(dir / "text.bag") << "not a bag";
   expectBagError([&] { BagImageReader(dir / "text.bag"); }, "text.bag");
   expectBagError([&] { BagImageReader(dir / "nothing.bag"); }, "nothing.bag");
@@ -224,13 +273,49 @@ TEST(BagIo, ClearErrors) {
   expectBagError([&] { BagImageReader(dir / "two.bag"); }, "2 image topics");
   EXPECT_EQ(BagImageReader(dir / "two.bag", "/b/image").size(), 1u);
 
-  sensor_msgs::Image truncated = imageMessage(cv::Mat1b(4, 4, static_cast<unsigned char>(1)), 1.0, "a");
-  truncated.data.resize(10);
-  expectBagError([&] { imageFromMessage(truncated); }, "too few");
+  const sensor_msgs::Image good = imageMessage(cv::Mat1b(4, 4, static_cast<unsigned char>(1)), 1.0, "a");
+  sensor_msgs::Image message = good;
+  message.data.resize(10);
+  expectBagError([&] { imageFromMessage(message); }, "'mono8' image of 4x4 has step 4 and 10 bytes: too few");
+  message.data.resize(20);
+  expectBagError([&] { imageFromMessage(message); }, "too many");
+  message = good;
+  message.step = 3;
+  expectBagError([&] { imageFromMessage(message); }, "a row needs 4");
+  message = good;
+  message.width = 0;
+  expectBagError([&] { imageFromMessage(message); }, "no pixels");
+  message = good;
+  message.height = 0;
+  message.data.clear();
+  expectBagError([&] { imageFromMessage(message); }, "no pixels");
+  message = good;
+  message.width = 3000000000u;
+  expectBagError([&] { imageFromMessage(message); }, "too large");
+  message = good;
+  message.height = (1u << 28) + 1;  // height x step wraps in 32 bits to the data's size
+  message.step = 16;
+  message.data.resize(16);
+  expectBagError([&] { imageFromMessage(message); }, "too few");
+  message = imageMessage(cv::Mat1w(4, 4, static_cast<std::uint16_t>(1)), 1.0, "a");
+  message.step = 9;
+  message.data.resize(36);
+  expectBagError([&] { imageFromMessage(message); }, "has step 9: not a multiple of its 2-byte channel values");
+  message = good;
+  message.encoding = "8UC2";
+  message.width = 2;
+  expectBagError([&] { imageFromMessage(message); }, "unsupported image encoding '8UC2'");
+  message.encoding = "16SC1";
+  expectBagError([&] { imageFromMessage(message); }, "unsupported image encoding '16SC1'");
+  message.encoding = "";
+  expectBagError([&] { imageFromMessage(message); }, "unsupported image encoding ''");
+
   sensor_msgs::CompressedImage garbage;
   garbage.format = "png";
   garbage.data = {1, 2, 3};
-  expectBagError([&] { imageFromMessage(garbage); }, "cannot decode");
+  expectBagError([&] { imageFromMessage(garbage); }, "cannot decode compressed image (format 'png', 3 bytes)");
+  garbage.data.clear();
+  expectBagError([&] { imageFromMessage(garbage); }, "no data");
 
   CameraParameters camera;
   camera.intrinsics = {100, 100, 50, 50, 100, 100};

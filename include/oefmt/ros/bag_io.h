@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Image streams in ROS 1 bags: reading raw sensor_msgs/Image (common encodings) or
-// sensor_msgs/CompressedImage with intrinsics from a CameraInfo topic, and writing flights.
+// Image streams in ROS 1 bags: reading raw sensor_msgs/Image or sensor_msgs/CompressedImage
+// (converted by cv_bridge) with intrinsics from a CameraInfo topic, and writing flights.
 #pragma once
 
 #include <cstddef>
@@ -26,16 +26,17 @@ class BagError : public std::runtime_error {
   explicit BagError(const std::string& what) : std::runtime_error(what) {}
 };
 
-/// Encodings of sensor_msgs/Image that imageFromMessage decodes.
-const std::vector<std::string>& supportedImageEncodings();
-
-/// A copy of the message's pixels: grey as mono 8/16-bit or 32/64-bit float, colour in OpenCV's
-/// BGR(A) order (rgb8/rgba8/rgb16/rgba16 are reordered). Big-endian data is byte-swapped.
-/// Throws BagError for an unsupported encoding or inconsistent sizes.
+/// The message's pixels as the estimator takes them, converted by cv_bridge: encodings that say
+/// what their channels are (mono, colour, Bayer, yuv422) become grey as OpenCV weighs colours,
+/// mono16 for 16-bit ones, mono8 otherwise; generic ones (8UC1, 16UC1, 32FC1, 64FC1; 8UC3 and
+/// the like, taken as BGR(A) by the estimator) come as stored. Big-endian data is byte-swapped.
+/// Throws BagError, naming the encoding, for an encoding cv_bridge does not know or cannot make
+/// grey, other pixel types (signed, two channels), no pixels, or a step and data size that do
+/// not fit the width, height and encoding.
 cv::Mat imageFromMessage(const sensor_msgs::Image& message);
 
-/// Decodes a CompressedImage (PNG, JPEG, ... via cv::imdecode; colour in BGR order).
-/// Throws BagError when it cannot be decoded.
+/// Decodes a CompressedImage with cv_bridge (cv::imdecode: PNG, JPEG, ...) and makes it grey at
+/// its own depth (8 bits, or 16 for a 16-bit PNG). Throws BagError when it cannot be decoded.
 cv::Mat imageFromMessage(const sensor_msgs::CompressedImage& message);
 
 /// A sensor_msgs/Image holding `image` (8UC1 mono8, 16UC1 mono16, 8UC3 bgr8, 8UC4 bgra8,
@@ -54,7 +55,7 @@ CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info);
 
 /// One image read from a bag.
 struct BagFrame {
-  cv::Mat image;         ///< see imageFromMessage
+  cv::Mat image;         ///< see imageFromMessage (grey, or as stored for generic encodings)
   double stamp = 0.0;    ///< header stamp [s]; the bag's record time when the header's is zero
   std::string encoding;  ///< the Image encoding, or "compressed <format>"
   std::string frame_id;
