@@ -9,6 +9,7 @@
 
 #include <boost/make_shared.hpp>
 #include <cv_bridge/cv_bridge.h>
+#include <image_geometry/pinhole_camera_model.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/distortion_models.h>
@@ -176,17 +177,8 @@ sensor_msgs::CameraInfo cameraInfoMessage(const CameraParameters& camera, double
 }
 
 CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info) {
-  CameraParameters camera;
-  Intrinsics& k = camera.intrinsics;
-  k.fx = info.K[0];
-  k.fy = info.K[4];
-  k.cx = info.K[2];
-  k.cy = info.K[5];
-  k.width = static_cast<int>(info.width);
-  k.height = static_cast<int>(info.height);
-  if (!(k.fx > 0.0 && k.fy > 0.0)) throw BagError("CameraInfo has no calibration (K is zero)");
-  if (!(std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy))) {
-    throw BagError("CameraInfo K is not finite");
+  for (double value : info.K) {
+    if (!std::isfinite(value)) throw BagError("CameraInfo K is not finite");
   }
   for (double d : info.D) {
     if (!std::isfinite(d)) throw BagError("CameraInfo distortion coefficients (D) are not finite");
@@ -210,8 +202,24 @@ CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info) {
                      info.distortion_model + " has " + std::to_string(count));
     }
   }
+  // image_geometry's camera model gives K for the images as sent: binned, and shifted to a
+  // region of interest, as the CameraInfo says.
+  image_geometry::PinholeCameraModel model;
+  model.fromCameraInfo(info);
+  const cv::Matx33d& matrix = model.intrinsicMatrix();
+  CameraParameters camera;
+  Intrinsics& k = camera.intrinsics;
+  k.fx = matrix(0, 0);
+  k.fy = matrix(1, 1);
+  k.cx = matrix(0, 2);
+  k.cy = matrix(1, 2);
+  const cv::Rect roi = model.rawRoi();
+  k.width = roi.width / static_cast<int>(model.binningX());
+  k.height = roi.height / static_cast<int>(model.binningY());
+  if (!(k.fx > 0.0 && k.fy > 0.0)) throw BagError("CameraInfo has no calibration (K is zero)");
+  const cv::Mat_<double>& coefficients = model.distortionCoeffs();
+  const auto coefficient = [&coefficients](int i) { return i < static_cast<int>(coefficients.total()) ? coefficients(i) : 0.0; };
   Distortion& d = camera.distortion;
-  const auto coefficient = [&info](std::size_t i) { return i < info.D.size() ? info.D[i] : 0.0; };
   d.k1 = coefficient(0);
   d.k2 = coefficient(1);
   d.p1 = coefficient(2);

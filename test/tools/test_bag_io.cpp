@@ -341,6 +341,31 @@ TEST(BagIo, CameraInfoRoundTrip) {
   EXPECT_THROW(cameraFromInfo(uncalibrated), BagError);
 }
 
+// A binned camera, or one sending a region of interest: the intrinsics of the images it sends.
+TEST(BagIo, CameraInfoOfBinnedAndCroppedImages) {
+  CameraParameters camera;
+  camera.intrinsics = {800.0, 804.0, 639.5, 479.5, 1280, 960};
+  sensor_msgs::CameraInfo info = cameraInfoMessage(camera, 3.0, "cam");
+  info.binning_x = info.binning_y = 2;
+  CameraParameters binned = cameraFromInfo(info);
+  EXPECT_DOUBLE_EQ(binned.intrinsics.fx, 400.0);
+  EXPECT_DOUBLE_EQ(binned.intrinsics.fy, 402.0);
+  EXPECT_DOUBLE_EQ(binned.intrinsics.cx, 319.75);
+  EXPECT_EQ(binned.intrinsics.width, 640);
+  EXPECT_EQ(binned.intrinsics.height, 480);
+  info.binning_x = info.binning_y = 0;
+  info.roi.x_offset = 100;
+  info.roi.y_offset = 40;
+  info.roi.width = 640;
+  info.roi.height = 480;
+  const CameraParameters cropped = cameraFromInfo(info);
+  EXPECT_DOUBLE_EQ(cropped.intrinsics.fx, 800.0);
+  EXPECT_DOUBLE_EQ(cropped.intrinsics.cx, 539.5);
+  EXPECT_DOUBLE_EQ(cropped.intrinsics.cy, 439.5);
+  EXPECT_EQ(cropped.intrinsics.width, 640);
+  EXPECT_EQ(cropped.intrinsics.height, 480);
+}
+
 // The models both programs take (through OpenCV), and a clear error naming any other.
 TEST(BagIo, CameraInfoDistortionModels) {
   CameraParameters camera;

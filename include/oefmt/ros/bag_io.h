@@ -47,8 +47,10 @@ sensor_msgs::Image imageMessage(const cv::Mat& image, double stamp, const std::s
 /// the eight coefficients when k4..k6 are not zero), K, R = I, P = [K | 0].
 sensor_msgs::CameraInfo cameraInfoMessage(const CameraParameters& camera, double stamp,
                                           const std::string& frame_id);
-/// Intrinsics and distortion of a CameraInfo: plumb_bob (D = k1 k2 p1 p2 [k3]) or
-/// rational_polynomial (D = k1 k2 p1 p2 k3 k4 k5 k6); an empty model only without distortion.
+/// Intrinsics and distortion of a CameraInfo, read by image_geometry's camera model: K and the
+/// size of the images as sent (binning and a region of interest applied); plumb_bob (D = k1 k2
+/// p1 p2 [k3]) or rational_polynomial (D = k1 k2 p1 p2 k3 k4 k5 k6); an empty model only without
+/// distortion.
 /// Throws BagError, naming the model, for another model (e.g. equidistant), for more coefficients
 /// than the model has, for a zero K and for non-finite values.
 CameraParameters cameraFromInfo(const sensor_msgs::CameraInfo& info);
