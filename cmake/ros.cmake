@@ -3,7 +3,7 @@
 # nodelet plugin oefmt/OdometryNodelet and the standalone oefmt_node.
 
 add_library(oefmt_ros src/ros/odometry_ros.cpp src/ros/parameter_yaml.cpp src/ros/stamp_guard.cpp
-                      src/ros/estimate_messages.cpp)
+                      src/ros/estimate_messages.cpp src/ros/rectification.cpp)
 target_link_libraries(oefmt_ros PUBLIC oefmt_io oefmt_bag_io ${catkin_LIBRARIES})
 target_include_directories(oefmt_ros SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 add_dependencies(oefmt_ros ${PROJECT_NAME}_generate_messages_cpp ${catkin_EXPORTED_TARGETS})

@@ -286,6 +286,15 @@ void Undistorter::setUp(int working_size) {
     }
   }
   cv::convertMaps(mx, my, map_xy_, map_fraction_, CV_16SC2);
+  // The same sampling as a camera: the lens's intrinsics in the pixels of the (shrunk) part,
+  // offset by the margin sourceFrame() adds.
+  source_camera_.distortion = input_.distortion;
+  source_camera_.intrinsics = Intrinsics{k.fx * sx,
+                                         k.fy * sy,
+                                         (k.cx - x0 + 0.5) * sx - 0.5 + kSourceMargin,
+                                         (k.cy - y0 + 0.5) * sy - 0.5 + kSourceMargin,
+                                         source.width + 2 * kSourceMargin,
+                                         source.height + 2 * kSourceMargin};
 
   // The horizontal field of view kept, for describe(): the lens's over the square's middle row.
   const double left = (image_size_.width - side) / 2.0;
@@ -295,8 +304,7 @@ void Undistorter::setUp(int working_size) {
   kept_width_ = lens_width > 0.0 ? working_size / output_.fx / lens_width : 1.0;
 }
 
-cv::Mat Undistorter::apply(const cv::Mat& image, ChannelOrder order) const {
-  if (!remaps()) return image;
+cv::Mat1f Undistorter::sampledPart(const cv::Mat& image, ChannelOrder order) const {
   // The working frame would hide a frame too small to register: refused as prepareImage does.
   requireRegistrableSize(image);
   if (image.size() != image_size_) {
@@ -309,9 +317,22 @@ cv::Mat Undistorter::apply(const cv::Mat& image, ChannelOrder order) const {
     cv::resize(grey, shrunk, reduced_, 0.0, 0.0, cv::INTER_AREA);
     grey = shrunk;
   }
+  return grey;
+}
+
+cv::Mat Undistorter::apply(const cv::Mat& image, ChannelOrder order) const {
+  if (!remaps()) return image;
   cv::Mat1f undistorted;
-  cv::remap(grey, undistorted, map_xy_, map_fraction_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  cv::remap(sampledPart(image, order), undistorted, map_xy_, map_fraction_, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   return undistorted;
+}
+
+cv::Mat1f Undistorter::sourceFrame(const cv::Mat& image, ChannelOrder order) const {
+  if (!remaps()) throw InputError("no lens distortion to undo: the frames are used as they are");
+  cv::Mat1f padded;
+  cv::copyMakeBorder(sampledPart(image, order), padded, kSourceMargin, kSourceMargin, kSourceMargin,
+                     kSourceMargin, cv::BORDER_REPLICATE);
+  return padded;
 }
 
 std::vector<std::string> Undistorter::notes() const {

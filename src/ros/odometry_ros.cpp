@@ -22,6 +22,7 @@
 #include "oefmt/estimation/pose.h"
 #include "oefmt/io/undistortion.h"
 #include "oefmt/io/fft_wisdom.h"
+#include "oefmt/ros/rectification.h"
 
 namespace oefmt {
 namespace {
@@ -374,7 +375,7 @@ void OdometryRos::process(const InputFrame& frame) {
     ++frames_rejected_;
     return;
   }
-  if (undistorter_) image = undistorter_->apply(image);
+  if (undistorter_) image = rectifyToWorkingFrame(*undistorter_, working_camera_, image);
   // Correlation surfaces cost copies: only while someone watches them.
   estimator_->setKeepSurfaces(rotation_zoom_publisher_.getNumSubscribers() > 0 ||
                               translation_publisher_.getNumSubscribers() > 0);
@@ -392,7 +393,8 @@ void OdometryRos::updateUndistorter(const CameraParameters& calibration, const s
   if (failed_camera_ && failed_camera_->madeFor(calibration, image_size)) {
     throw InputError(failed_camera_->error);  // the same calibration again: not set up again
   }
-  // Set up once per calibration and image size (the maps take a few milliseconds).
+  // Set up once per calibration and image size (finding the working frame takes a few
+  // milliseconds).
   undistorter_.reset();
   try {
     undistorter_ = std::make_unique<const Undistorter>(calibration, image_size,
@@ -403,6 +405,8 @@ void OdometryRos::updateUndistorter(const CameraParameters& calibration, const s
     ROS_ERROR_STREAM(name_ << ": " << failed_camera_->error);
     throw;
   }
+  // image_geometry makes (and keeps) the maps of this working frame.
+  if (undistorter_->remaps()) working_camera_.fromCameraInfo(workingFrameInfo(*undistorter_));
   for (const std::string& note : undistorter_->notes()) ROS_INFO_STREAM(name_ << ": " << note);
 }
 

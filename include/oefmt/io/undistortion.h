@@ -79,6 +79,18 @@ class Undistorter {
   /// (requireRegistrableSize). Thread-safe.
   cv::Mat apply(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr) const;
 
+  /// For a remap done elsewhere (the ROS node's, by image_geometry): the frame apply() resamples,
+  /// i.e. the part of `image` the working frame samples, grey float as apply() converts it and
+  /// shrunk alike, with a border of kSourceMargin pixels replicated around it (the bicubic
+  /// kernel's reach, so that a remap needs no border mode). Only when remaps(); throws
+  /// InputError as apply() does.
+  cv::Mat1f sourceFrame(const cv::Mat& image, ChannelOrder order = ChannelOrder::kBgr) const;
+  /// The camera of sourceFrame()'s pixels (intrinsics and their size, the lens's distortion):
+  /// remapping sourceFrame() from it to intrinsics() gives apply()'s working frame. Only when
+  /// remaps().
+  const CameraParameters& sourceCamera() const { return source_camera_; }
+  static constexpr int kSourceMargin = 2;
+
   /// What to tell the user, one line each: how a calibration of another resolution is mapped
   /// (describeSizeMapping) and what is undistorted (describe()); empty when neither applies.
   std::vector<std::string> notes() const;
@@ -87,6 +99,8 @@ class Undistorter {
 
  private:
   void setUp(int working_size);
+  /// The part of the frame the working frame samples, grey float, shrunk (see reduced_).
+  cv::Mat1f sampledPart(const cv::Mat& image, ChannelOrder order) const;
 
   cv::Size image_size_;
   std::string source_;
@@ -99,6 +113,7 @@ class Undistorter {
   cv::Rect roi_;             // the part of the frame the working frame comes from
   cv::Size reduced_;         // roi_ shrunk to about the working scale first (empty: not shrunk)
   cv::Mat map_xy_, map_fraction_;  // fixed-point maps (cv::convertMaps) into roi_ (or reduced_)
+  CameraParameters source_camera_;  // of roi_ (or reduced_) with the margin, see sourceFrame()
 };
 
 }  // namespace oefmt

@@ -15,6 +15,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
+#include <image_geometry/pinhole_camera_model.h>
 #include <image_transport/image_transport.h>
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
@@ -135,6 +136,7 @@ class OdometryRos {
   cv::Size input_size_;
   double estimator_fx_ = 0.0;
   std::unique_ptr<const Undistorter> undistorter_;  ///< of the current calibration and image size
+  image_geometry::PinholeCameraModel working_camera_;  ///< rectifies undistorter_'s working frames
   /// The last calibration that could not be set up, so that it is reported, not retried, per frame.
   struct FailedCamera {
     CameraParameters calibration;
