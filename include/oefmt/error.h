@@ -13,4 +13,14 @@ class InputError : public std::invalid_argument {
   explicit InputError(const std::string& what) : std::invalid_argument(what) {}
 };
 
+/// The validate() functions' check: an InputError with `message` unless `ok`.
+inline void requireInput(bool ok, const std::string& message) {
+  if (!ok) throw InputError(message);
+}
+
+/// A configuration value's check: an InputError "invalid parameter 'FIELD': RULE" unless `ok`.
+inline void requireParameter(bool ok, const std::string& field, const std::string& rule) {
+  if (!ok) throw InputError("invalid parameter '" + field + "': " + rule);
+}
+
 }  // namespace oefmt

@@ -16,10 +16,6 @@
 namespace oefmt {
 namespace {
 
-void require(bool ok, const std::string& field, const std::string& rule) {
-  if (!ok) throw InputError("invalid parameter '" + field + "': " + rule);
-}
-
 bool finiteIn(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 
 // ---- reading one value -------------------------------------------------------------------
@@ -120,9 +116,9 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   number("altitude", c.altitude), number("fx", c.fx),
                   boolean("parallel_registrations", c.parallel_registrations)},
                  [&c] {
-                   require(std::isfinite(c.altitude) && c.altitude >= 0.0, "altitude",
-                           "must be >= 0 m (0 = unknown)");
-                   require(std::isfinite(c.fx) && c.fx >= 0.0, "fx", "must be >= 0 px (0 = size)");
+                   requireParameter(std::isfinite(c.altitude) && c.altitude >= 0.0, "altitude",
+                                    "must be >= 0 m (0 = unknown)");
+                   requireParameter(std::isfinite(c.fx) && c.fx >= 0.0, "fx", "must be >= 0 px (0 = size)");
                  }});
   RegistrationConfig& r = c.registration;
   all.push_back({"registration",
@@ -256,44 +252,43 @@ EstimatorMode parseEstimatorMode(const std::string& text) {
 }
 
 void MatchingConfig::validate() const {
-  require(stretch_steps >= 2 && stretch_steps <= 1000, "stretch_steps", "must be in [2, 1000]");
-  require(finiteIn(stretch_key_12, 1.0, 100.0), "stretch_key_12", "must be in [1, 100] per mille");
-  require(finiteIn(stretch_key_02, 1.0, 100.0), "stretch_key_02", "must be in [1, 100] per mille");
-  require(finiteIn(stretch_init_window, 0.05, 10.0), "stretch_init_window", "must be in [0.05, 10]");
-  require(finiteIn(max_normalised_error, 0.01, 1.0), "max_normalised_error", "must be in [0.01, 1]");
-  require(finiteIn(smoothing_sigma, 0.0, 10.0), "smoothing_sigma", "must be in [0, 10] bins");
-  require(finiteIn(stretch_sigma_floor, 1e-6, 1.0), "stretch_sigma_floor", "must be in [1e-6, 1]");
-  require(finiteIn(shift_range, 1.0, 200.0), "shift_range", "must be in [1, 200] bins");
-  require(finiteIn(shift_step, 0.001, 0.5), "shift_step", "must be in [0.001, 0.5] bins");
-  require(finiteIn(shift_sigma_floor, 1e-6, 10.0), "shift_sigma_floor", "must be in [1e-6, 10] bins");
-  require(finiteIn(min_peak_bins, 0.0, 100.0), "min_peak_bins", "must be in [0, 100] bins");
-  require(skip_bins >= 0 && skip_bins <= 100, "skip_bins", "must be in [0, 100] bins");
+  requireParameter(stretch_steps >= 2 && stretch_steps <= 1000, "stretch_steps", "must be in [2, 1000]");
+  requireParameter(finiteIn(stretch_key_12, 1.0, 100.0), "stretch_key_12", "must be in [1, 100] per mille");
+  requireParameter(finiteIn(stretch_key_02, 1.0, 100.0), "stretch_key_02", "must be in [1, 100] per mille");
+  requireParameter(finiteIn(stretch_init_window, 0.05, 10.0), "stretch_init_window", "must be in [0.05, 10]");
+  requireParameter(finiteIn(max_normalised_error, 0.01, 1.0), "max_normalised_error", "must be in [0.01, 1]");
+  requireParameter(finiteIn(smoothing_sigma, 0.0, 10.0), "smoothing_sigma", "must be in [0, 10] bins");
+  requireParameter(finiteIn(stretch_sigma_floor, 1e-6, 1.0), "stretch_sigma_floor", "must be in [1e-6, 1]");
+  requireParameter(finiteIn(shift_range, 1.0, 200.0), "shift_range", "must be in [1, 200] bins");
+  requireParameter(finiteIn(shift_step, 0.001, 0.5), "shift_step", "must be in [0.001, 0.5] bins");
+  requireParameter(finiteIn(shift_sigma_floor, 1e-6, 10.0), "shift_sigma_floor", "must be in [1e-6, 10] bins");
+  requireParameter(finiteIn(min_peak_bins, 0.0, 100.0), "min_peak_bins", "must be in [0, 100] bins");
+  requireParameter(skip_bins >= 0 && skip_bins <= 100, "skip_bins", "must be in [0, 100] bins");
 }
 
 void TrackingConfig::validate() const {
-  require(finiteIn(layer_gate, 0.001, 1.0), "layer_gate", "must be in [0.001, 1]");
-  require(finiteIn(layer_search, 0.001, 1.0), "layer_search", "must be in [0.001, 1]");
-  require(finiteIn(layer_min_fraction, 0.0, 1.0), "layer_min_fraction", "must be in [0, 1]");
-  require(finiteIn(steady_layer_min_fraction, 0.0, 1.0), "steady_layer_min_fraction", "must be in [0, 1]");
-  require(max_failed_frames >= 0 && max_failed_frames <= 1000, "max_failed_frames",
-          "must be in [0, 1000]");
-  require(finiteIn(prediction_sigma, 0.0, 100.0), "prediction_sigma", "must be in [0, 100]");
-  require(finiteIn(motion_prior_sigma, 0.0, 100.0), "motion_prior_sigma", "must be in [0, 100]");
-  require(finiteIn(max_acceleration, 0.01, 1000.0), "max_acceleration", "must be in [0.01, 1000] m/s^2");
-  require(finiteIn(assumed_altitude, 0.01, 1e5), "assumed_altitude", "must be in [0.01, 1e5] m");
+  requireParameter(finiteIn(layer_gate, 0.001, 1.0), "layer_gate", "must be in [0.001, 1]");
+  requireParameter(finiteIn(layer_search, 0.001, 1.0), "layer_search", "must be in [0.001, 1]");
+  requireParameter(finiteIn(layer_min_fraction, 0.0, 1.0), "layer_min_fraction", "must be in [0, 1]");
+  requireParameter(finiteIn(steady_layer_min_fraction, 0.0, 1.0), "steady_layer_min_fraction", "must be in [0, 1]");
+  requireParameter(max_failed_frames >= 0 && max_failed_frames <= 1000, "max_failed_frames", "must be in [0, 1000]");
+  requireParameter(finiteIn(prediction_sigma, 0.0, 100.0), "prediction_sigma", "must be in [0, 100]");
+  requireParameter(finiteIn(motion_prior_sigma, 0.0, 100.0), "motion_prior_sigma", "must be in [0, 100]");
+  requireParameter(finiteIn(max_acceleration, 0.01, 1000.0), "max_acceleration", "must be in [0.01, 1000] m/s^2");
+  requireParameter(finiteIn(assumed_altitude, 0.01, 1e5), "assumed_altitude", "must be in [0.01, 1e5] m");
 }
 
 void UncertaintyConfig::validate() const {
-  require(finiteIn(rotation_scale, 1e-4, 100.0), "rotation_scale", "must be in [1e-4, 100]");
-  require(finiteIn(log_zoom_scale, 1e-4, 100.0), "log_zoom_scale", "must be in [1e-4, 100]");
-  require(finiteIn(shift_scale, 1e-4, 100.0), "shift_scale", "must be in [1e-4, 100]");
-  require(finiteIn(direction_scale, 1e-4, 100.0), "direction_scale", "must be in [1e-4, 100]");
+  requireParameter(finiteIn(rotation_scale, 1e-4, 100.0), "rotation_scale", "must be in [1e-4, 100]");
+  requireParameter(finiteIn(log_zoom_scale, 1e-4, 100.0), "log_zoom_scale", "must be in [1e-4, 100]");
+  requireParameter(finiteIn(shift_scale, 1e-4, 100.0), "shift_scale", "must be in [1e-4, 100]");
+  requireParameter(finiteIn(direction_scale, 1e-4, 100.0), "direction_scale", "must be in [1e-4, 100]");
 }
 
 void EfmtConfig::validate() const {
-  require(zoom_samples >= 1 && zoom_samples <= 50, "zoom_samples", "must be in [1, 50]");
-  require(finiteIn(zoom_threshold, 0.0, 1.0), "zoom_threshold", "must be in [0, 1]");
-  require(sector_half_width >= 0 && sector_half_width <= 64, "sector_half_width", "must be in [0, 64]");
+  requireParameter(zoom_samples >= 1 && zoom_samples <= 50, "zoom_samples", "must be in [1, 50]");
+  requireParameter(finiteIn(zoom_threshold, 0.0, 1.0), "zoom_threshold", "must be in [0, 1]");
+  requireParameter(sector_half_width >= 0 && sector_half_width <= 64, "sector_half_width", "must be in [0, 64]");
 }
 
 void EstimatorConfig::validate() const {

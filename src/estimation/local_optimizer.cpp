@@ -308,21 +308,18 @@ const char* toString(OptimizerStatus status) {
 }
 
 void LocalOptimizerOptions::validate() const {
-  const auto require = [](bool ok, const char* field, const char* rule) {
-    if (!ok) throw InputError(std::string("invalid parameter '") + field + "': " + rule);
-  };
-  require(max_iterations >= 1 && max_iterations <= 1000, "max_iterations", "must be in [1, 1000]");
-  require(std::isfinite(loss_scale) && loss_scale > 0.0, "loss_scale", "must be > 0");
-  require(std::isfinite(loop_translation_sigma) && loop_translation_sigma > 0.0,
-          "loop_translation_sigma", "must be > 0 px");
-  require(std::isfinite(loop_translation_sigma_relative) && loop_translation_sigma_relative >= 0.0,
-          "loop_translation_sigma_relative", "must be >= 0");
-  require(std::isfinite(loop_rotation_sigma) && loop_rotation_sigma > 0.0, "loop_rotation_sigma",
-          "must be > 0 rad");
-  require(std::isfinite(loop_log_zoom_sigma) && loop_log_zoom_sigma > 0.0, "loop_log_zoom_sigma",
-          "must be > 0");
-  require(std::isfinite(function_tolerance) && function_tolerance > 0.0 && function_tolerance < 1.0,
-          "function_tolerance", "must be in (0, 1)");
+  requireParameter(max_iterations >= 1 && max_iterations <= 1000, "max_iterations", "must be in [1, 1000]");
+  requireParameter(std::isfinite(loss_scale) && loss_scale > 0.0, "loss_scale", "must be > 0");
+  requireParameter(std::isfinite(loop_translation_sigma) && loop_translation_sigma > 0.0, "loop_translation_sigma",
+                   "must be > 0 px");
+  requireParameter(std::isfinite(loop_translation_sigma_relative) && loop_translation_sigma_relative >= 0.0,
+                   "loop_translation_sigma_relative", "must be >= 0");
+  requireParameter(std::isfinite(loop_rotation_sigma) && loop_rotation_sigma > 0.0, "loop_rotation_sigma",
+                   "must be > 0 rad");
+  requireParameter(std::isfinite(loop_log_zoom_sigma) && loop_log_zoom_sigma > 0.0, "loop_log_zoom_sigma",
+                   "must be > 0");
+  requireParameter(std::isfinite(function_tolerance) && function_tolerance > 0.0 && function_tolerance < 1.0,
+                   "function_tolerance", "must be in (0, 1)");
 }
 
 LocalOptimizer::LocalOptimizer(const LocalOptimizerOptions& options) : options_(options) {

@@ -7,32 +7,24 @@
 #include "oefmt/error.h"
 
 namespace oefmt {
-namespace {
-
-void require(bool ok, const std::string& field, const std::string& rule) {
-  if (!ok) throw InputError("invalid parameter '" + field + "': " + rule);
-}
-
-}  // namespace
-
 void RegistrationConfig::validate() const {
-  require(size >= 64 && size % 2 == 0, "size", "must be even and >= 64, got " + std::to_string(size));
-  require(taper_fraction >= 0.0 && taper_fraction <= 0.5, "taper_fraction", "must be in [0, 0.5]");
-  require(logpolar_radius_fraction > 0.05 && logpolar_radius_fraction <= 0.75,
-          "logpolar_radius_fraction", "must be in (0.05, 0.75]");
-  require(polar_radius_fraction > 0.05 && polar_radius_fraction <= 1.0, "polar_radius_fraction",
-          "must be in (0.05, 1]");
-  require(block_radius >= 0 && block_radius <= 10, "block_radius", "must be in [0, 10]");
-  require(std::isfinite(energy_smoothing_sigma) && energy_smoothing_sigma >= 0.0 &&
-              energy_smoothing_sigma <= 10.0,
-          "energy_smoothing_sigma", "must be in [0, 10] bins");
-  require(std::isfinite(min_texture) && min_texture >= 0.0, "min_texture", "must be >= 0");
-  require(std::isfinite(min_confidence) && min_confidence >= 0.0 && min_confidence <= 1.0,
-          "min_confidence", "must be in [0, 1]");
-  require(rotation_zoom_candidates >= 1 && rotation_zoom_candidates <= 10, "rotation_zoom_candidates",
-          "must be in [1, 10]");
-  require(std::isfinite(identity_warp_px) && identity_warp_px >= 0.0 && identity_warp_px <= 1.0,
-          "identity_warp_px", "must be in [0, 1] px");
+  requireParameter(size >= 64 && size % 2 == 0, "size", "must be even and >= 64, got " + std::to_string(size));
+  requireParameter(taper_fraction >= 0.0 && taper_fraction <= 0.5, "taper_fraction", "must be in [0, 0.5]");
+  requireParameter(logpolar_radius_fraction > 0.05 && logpolar_radius_fraction <= 0.75, "logpolar_radius_fraction",
+                   "must be in (0.05, 0.75]");
+  requireParameter(polar_radius_fraction > 0.05 && polar_radius_fraction <= 1.0, "polar_radius_fraction",
+                   "must be in (0.05, 1]");
+  requireParameter(block_radius >= 0 && block_radius <= 10, "block_radius", "must be in [0, 10]");
+  requireParameter(
+      std::isfinite(energy_smoothing_sigma) && energy_smoothing_sigma >= 0.0 && energy_smoothing_sigma <= 10.0,
+      "energy_smoothing_sigma", "must be in [0, 10] bins");
+  requireParameter(std::isfinite(min_texture) && min_texture >= 0.0, "min_texture", "must be >= 0");
+  requireParameter(std::isfinite(min_confidence) && min_confidence >= 0.0 && min_confidence <= 1.0, "min_confidence",
+                   "must be in [0, 1]");
+  requireParameter(rotation_zoom_candidates >= 1 && rotation_zoom_candidates <= 10, "rotation_zoom_candidates",
+                   "must be in [1, 10]");
+  requireParameter(std::isfinite(identity_warp_px) && identity_warp_px >= 0.0 && identity_warp_px <= 1.0,
+                   "identity_warp_px", "must be in [0, 1] px");
 }
 
 bool operator==(const RegistrationConfig& a, const RegistrationConfig& b) {

@@ -79,30 +79,27 @@ float wallDarkening(Facing facing) {
 }  // namespace
 
 void SceneConfig::validate() const {
-  auto require = [](bool ok, const std::string& what) {
-    if (!ok) throw InputError("scene: " + what);
-  };
-  require(cell_size > 0.0 && std::isfinite(cell_size), "cell_size must be > 0");
-  require(terrace_cells >= 1, "terrace_cells must be >= 1");
-  require(gap >= 0.0 && gap < 0.5, "gap must be in [0, 0.5)");
-  require(fill >= 0.0 && fill <= 1.0, "fill must be in [0, 1]");
-  require(texel > 0.0 && std::isfinite(texel), "texel must be > 0");
-  require(texture_size >= 64, "texture_size must be >= 64");
-  require(feature_texels >= 2.0, "feature_texels must be >= 2");
+  requireInput(cell_size > 0.0 && std::isfinite(cell_size), "scene: cell_size must be > 0");
+  requireInput(terrace_cells >= 1, "scene: terrace_cells must be >= 1");
+  requireInput(gap >= 0.0 && gap < 0.5, "scene: gap must be in [0, 0.5)");
+  requireInput(fill >= 0.0 && fill <= 1.0, "scene: fill must be in [0, 1]");
+  requireInput(texel > 0.0 && std::isfinite(texel), "scene: texel must be > 0");
+  requireInput(texture_size >= 64, "scene: texture_size must be >= 64");
+  requireInput(feature_texels >= 2.0, "scene: feature_texels must be >= 2");
   for (double pattern : pattern_texels) {
-    require(pattern > 0.0 && std::isfinite(pattern), "pattern_texels must be > 0");
+    requireInput(pattern > 0.0 && std::isfinite(pattern), "scene: pattern_texels must be > 0");
   }
-  require(texture_std >= 0.0 && texture_std <= 0.5, "texture_std must be in [0, 0.5]");
+  requireInput(texture_std >= 0.0 && texture_std <= 0.5, "scene: texture_std must be in [0, 0.5]");
   // The renderer's layer map codes level k as k and its walls as 128 + k.
-  require(levels.size() <= 126, "at most 126 raised levels");
+  requireInput(levels.size() <= 126, "scene: at most 126 raised levels");
   double shares = 0.0;
   for (const BlockLevel& level : levels) {
-    require(level.height > 0.0 && std::isfinite(level.height), "level heights must be > 0");
-    require(level.incline_deg >= 0.0 && level.incline_deg < 45.0, "level inclines must be in [0, 45) deg");
-    require(level.share >= 0.0, "level shares must be >= 0");
+    requireInput(level.height > 0.0 && std::isfinite(level.height), "scene: level heights must be > 0");
+    requireInput(level.incline_deg >= 0.0 && level.incline_deg < 45.0, "scene: level inclines must be in [0, 45) deg");
+    requireInput(level.share >= 0.0, "scene: level shares must be >= 0");
     shares += level.share;
   }
-  require(shares <= 1.0 + 1e-9, "the levels' shares must add up to at most 1");
+  requireInput(shares <= 1.0 + 1e-9, "scene: the levels' shares must add up to at most 1");
 }
 
 double SceneConfig::levelReach(const BlockLevel& level) const {

@@ -78,22 +78,19 @@ std::vector<FlightPose> makeSpin(const TrackConfig& config) {
 }  // namespace
 
 void TrackConfig::validate() const {
-  auto require = [](bool ok, const std::string& what) {
-    if (!ok) throw InputError("track: " + what);
-  };
   if (isMoving(shape)) {
-    require(length > 0.0 && std::isfinite(length), "length must be > 0");
+    requireInput(length > 0.0 && std::isfinite(length), "track: length must be > 0");
   } else {
-    require(climb == 0.0, "a spin does not climb (climb must be 0)");
-    require(heading == HeadingMode::kFixed, "a spin does not move: its heading cannot follow the track");
+    requireInput(climb == 0.0, "track: a spin does not climb (climb must be 0)");
+    requireInput(heading == HeadingMode::kFixed, "track: a spin does not move: its heading cannot follow the track");
   }
-  require(frames >= 2, "frames must be >= 2");
-  require(altitude > 0.0 && std::isfinite(altitude), "altitude must be > 0");
-  require(std::isfinite(climb) && altitude + climb > 0.0, "altitude + climb must stay > 0");
-  require(!(climb_profile == ClimbProfile::kRamp && isClosed(shape)),
-          "a loop must come back to its start: climb profile ramp needs a line track");
-  require(std::isfinite(yaw) && std::isfinite(line_direction), "angles must be finite");
-  require(std::isfinite(spin_rate) && std::fabs(spin_rate) < CV_PI, "spin rate must be in (-180, 180) deg");
+  requireInput(frames >= 2, "track: frames must be >= 2");
+  requireInput(altitude > 0.0 && std::isfinite(altitude), "track: altitude must be > 0");
+  requireInput(std::isfinite(climb) && altitude + climb > 0.0, "track: altitude + climb must stay > 0");
+  requireInput(!(climb_profile == ClimbProfile::kRamp && isClosed(shape)),
+               "track: a loop must come back to its start: climb profile ramp needs a line track");
+  requireInput(std::isfinite(yaw) && std::isfinite(line_direction), "track: angles must be finite");
+  requireInput(std::isfinite(spin_rate) && std::fabs(spin_rate) < CV_PI, "track: spin rate must be in (-180, 180) deg");
 }
 
 bool isClosed(TrackShape shape) { return shape == TrackShape::kCircle || shape == TrackShape::kEight; }
