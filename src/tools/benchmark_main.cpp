@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "command_line.h"
 #include "oefmt/registration/energy_vector.h"
 #include "oefmt/io/image_decoding.h"
 #include "oefmt/io/image_encoding.h"
@@ -352,20 +353,32 @@ BENCHMARK(BM_Stage_PeakAndEnergyVector)->Unit(benchmark::kMicrosecond);
 }  // namespace
 
 int main(int argc, char** argv) {
-  oefmt::useDefaultFftWisdom();
+  CLI::App app(
+      "Time of one pair registration at N = 512 and of each of its stages (Google Benchmark; its\n"
+      "own options, --benchmark_filter=REGEX and the others, are passed on to it).",
+      "oefmt_benchmark");
+  oefmt::tools::setUpTool(app, "Google Benchmark's options follow.");
+  app.allow_extras();
   int threads = 1;
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (std::strcmp(argv[i], "--threads") == 0) {
-      threads = std::atoi(argv[i + 1]);
-      for (int j = i; j + 2 <= argc; ++j) argv[j] = argv[j + 2];
-      argc -= 2;
-      break;
-    }
+  app.add_option("--threads", threads, "OpenCV threads (default 1: FFTW is single-threaded too)")->type_name("K");
+  if (const std::optional<int> exit_status = oefmt::tools::parseCommandLine(app, argc, argv)) {
+    if (*exit_status != 0) return *exit_status;
+    char help[] = "--help";  // Google Benchmark lists its options and exits
+    char* help_argv[] = {argv[0], help, nullptr};
+    int help_argc = 2;
+    benchmark::Initialize(&help_argc, help_argv);
+    return 0;
   }
+  std::vector<std::string> rest = app.remaining();
+  std::vector<char*> benchmark_argv = {argv[0]};
+  for (std::string& arg : rest) benchmark_argv.push_back(arg.data());
+  int benchmark_argc = static_cast<int>(benchmark_argv.size());
+  benchmark_argv.push_back(nullptr);
+  benchmark::Initialize(&benchmark_argc, benchmark_argv.data());
+  if (benchmark::ReportUnrecognizedArguments(benchmark_argc, benchmark_argv.data())) return 1;
+  oefmt::useDefaultFftWisdom();
   cv::setNumThreads(threads);
   inputs();  // plan FFTs and render the test frames before any timing starts
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -21,42 +22,6 @@
 extern char** environ;
 
 namespace {
-
-const char* const kUsage = R"(usage: oefmt_evaluate [options] ESTIMATE.tum GROUNDTRUTH.tum
-
-Aligns the estimate to the ground truth by least squares (Umeyama; similarity in x-y by default)
-and prints the absolute trajectory error (rmse, mean, median, max), the drift (relative position
-error per distance travelled, over segments of 10..50 % of the path), the loop error (gap between
-the estimate's and the truth's first-to-last displacement) and the errors of the heading steps
-(yaw change between consecutive poses) as a table, then one line of JSON.
-TUM files: 't x y z qx qy qz qw' per line, '#' comments.
-
-options:
-  --match time|index   associate by timestamp (default) or by line index
-  --tolerance S        largest time difference of a match [s] (default 0.02)
-  --3d                 align and measure in 3-D (default: x-y only)
-  --no-scale           rigid alignment (default: with scale, for monocular estimates)
-  --segments F,F,...   drift segment lengths as fractions of the path (default 0.1,0.2,0.3,0.4,0.5)
-  --heading-threshold DEG  heading steps off by more than this are counted (default 2)
-  --plot FILE.png      draw both trajectories (top view) and the error over time
-  --title TEXT         plot title
-  --aligned FILE.tum   write the aligned, matched estimate
-  --json-only          print only the JSON line
-  --python EXE         interpreter for the plot (default /usr/bin/python3 if present)
-  --plot-script FILE   plot script (default: plot_trajectory.py next to this program, else the
-                       source tree's scripts/)
-  -h, --help
-exit codes: 0 success, 1 unreadable input or too few matches, 2 invalid option, 3 plot failed)";
-
-std::vector<double> fractionList(const std::string& text) {
-  const std::vector<double> values = oefmt::tools::numberList("--segments", text);
-  for (const double v : values) {
-    if (!(v > 0.0 && v <= 1.0)) {
-      throw oefmt::InputError("--segments needs fractions in (0, 1] separated by commas, got '" + text + "'");
-    }
-  }
-  return values;
-}
 
 std::string defaultPlotScript() {
   std::error_code error;
@@ -94,69 +59,83 @@ void writePlotData(const std::string& path, const oefmt::EvaluationResult& resul
   std::fclose(file);
 }
 
+struct Command {
+  oefmt::EvaluationOptions options;
+  std::string estimate, truth, plot, title, aligned_path, python, script;
+  bool json_only = false;
+};
+
+/// Reads the command line into `c`; returns the exit status when the tool is to stop here.
+std::optional<int> parse(int argc, char** argv, Command& c) {
+  using oefmt::requireInput;
+  CLI::App app(R"(Aligns the estimate to the ground truth by least squares (Umeyama; similarity in x-y by default)
+and prints the absolute trajectory error (rmse, mean, median, max), the drift (relative position
+error per distance travelled, over segments of 10..50 % of the path), the loop error (gap between
+the estimate's and the truth's first-to-last displacement) and the errors of the heading steps
+(yaw change between consecutive poses) as a table, then one line of JSON.
+TUM files: 't x y z qx qy qz qw' per line, '#' comments.)",
+               "oefmt_evaluate");
+  oefmt::tools::setUpTool(
+      app, "exit codes: 0 success, 1 unreadable input or too few matches, 2 invalid option, 3 plot failed");
+  app.add_option("ESTIMATE.tum", c.estimate, "estimated trajectory")->type_name("")->required();
+  app.add_option("GROUNDTRUTH.tum", c.truth, "ground truth")->type_name("")->required();
+  oefmt::tools::addChoice(app, "--match", c.options.association,
+                          {{"time", oefmt::AssociationMode::kTimestamp}, {"index", oefmt::AssociationMode::kIndex}},
+                          "associate by timestamp (default) or by line index");
+  const CLI::Option* tolerance = oefmt::tools::addNumber(app, "--tolerance", c.options.time_tolerance, "S",
+                                                         "largest time difference of a match [s] (default 0.02)");
+  app.add_flag_callback("--3d", [&c] { c.options.planar = false; }, "align and measure in 3-D (default: x-y only)");
+  app.add_flag_callback("--no-scale", [&c] { c.options.with_scale = false; },
+                        "rigid alignment (default: with scale, for monocular estimates)");
+  oefmt::tools::addNumberList(app, "--segments", c.options.drift_segment_fractions, "F,F,...",
+                              "drift segment lengths as fractions of the path (default 0.1,0.2,0.3,0.4,0.5)");
+  app.add_option_function<double>(
+         "--heading-threshold",
+         [&c](double degrees) {
+           requireInput(degrees > 0.0 && degrees < 180.0, "--heading-threshold must be in (0, 180) degrees");
+           c.options.heading_step_threshold = degrees * M_PI / 180.0;
+         },
+         "heading steps off by more than this are counted (default 2)")
+      ->type_name("DEG")
+      ->check(oefmt::tools::finite());
+  app.add_option("--plot", c.plot, "draw both trajectories (top view) and the error over time")->type_name("FILE.png");
+  app.add_option("--title", c.title, "plot title")->type_name("TEXT");
+  app.add_option("--aligned", c.aligned_path, "write the aligned, matched estimate")->type_name("FILE.tum");
+  app.add_flag("--json-only", c.json_only, "print only the JSON line");
+  app.add_option("--python", c.python, "interpreter for the plot (default /usr/bin/python3 if present)")
+      ->type_name("EXE");
+  app.add_option("--plot-script", c.script,
+                 "plot script (default: plot_trajectory.py next to this program, else the\n"
+                 "source tree's scripts/)")
+      ->type_name("FILE");
+  app.callback([&c, tolerance] {
+    requireInput(tolerance->count() == 0 || c.options.time_tolerance >= 0.0,
+                 "--tolerance needs a number of seconds >= 0");
+    for (const double v : c.options.drift_segment_fractions) {
+      if (!(v > 0.0 && v <= 1.0)) {
+        std::ostringstream message;
+        message << "--segments needs fractions in (0, 1] separated by commas, got " << v;
+        throw oefmt::InputError(message.str());
+      }
+    }
+  });
+  return oefmt::tools::parseCommandLine(app, argc, argv);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  oefmt::EvaluationOptions options;
-  std::string plot, title, aligned_path, python, script;
-  bool json_only = false;
-  std::vector<std::string> paths;
-  try {
-    oefmt::tools::Arguments args(argc, argv);
-    while (!args.done()) {
-      const std::string arg = args.take();
-      const auto value = [&]() { return args.value(arg); };
-      if (arg == "-h" || arg == "--help") {
-        std::puts(kUsage);
-        return 0;
-      } else if (arg == "--match") {
-        const std::string mode = value();
-        if (mode != "time" && mode != "index") throw oefmt::InputError("--match must be time or index");
-        options.association = mode == "time" ? oefmt::AssociationMode::kTimestamp : oefmt::AssociationMode::kIndex;
-      } else if (arg == "--tolerance") {
-        options.time_tolerance = args.number(arg);
-        if (!(options.time_tolerance >= 0.0)) throw oefmt::InputError("--tolerance needs a number of seconds >= 0");
-      } else if (arg == "--3d") {
-        options.planar = false;
-      } else if (arg == "--no-scale") {
-        options.with_scale = false;
-      } else if (arg == "--segments") {
-        options.drift_segment_fractions = fractionList(value());
-      } else if (arg == "--heading-threshold") {
-        const double degrees = args.number(arg);
-        if (!(degrees > 0.0 && degrees < 180.0)) throw oefmt::InputError("--heading-threshold must be in (0, 180) degrees");
-        options.heading_step_threshold = degrees * M_PI / 180.0;
-      } else if (arg == "--plot") {
-        plot = value();
-      } else if (arg == "--title") {
-        title = value();
-      } else if (arg == "--aligned") {
-        aligned_path = value();
-      } else if (arg == "--json-only") {
-        json_only = true;
-      } else if (arg == "--python") {
-        python = value();
-      } else if (arg == "--plot-script") {
-        script = value();
-      } else if (!arg.empty() && arg[0] == '-') {
-        throw oefmt::InputError("unknown option '" + arg + "' (see --help)");
-      } else {
-        paths.push_back(arg);
-      }
-    }
-    if (paths.size() != 2) throw oefmt::InputError("expected ESTIMATE.tum and GROUNDTRUTH.tum (see --help)");
-  } catch (const oefmt::InputError& e) {
-    std::fprintf(stderr, "oefmt_evaluate: %s\n", e.what());
-    return 2;
-  }
-
+  Command command;
+  if (const std::optional<int> exit_status = parse(argc, argv, command)) return *exit_status;
+  const oefmt::EvaluationOptions& options = command.options;
   oefmt::EvaluationResult result;
   try {
-    const oefmt::StampedTrajectory estimate = oefmt::readTum(paths[0]);
-    const oefmt::StampedTrajectory truth = oefmt::readTum(paths[1]);
+    const oefmt::StampedTrajectory estimate = oefmt::readTum(command.estimate);
+    const oefmt::StampedTrajectory truth = oefmt::readTum(command.truth);
     result = oefmt::evaluateTrajectory(estimate, truth, options);
-    if (!aligned_path.empty()) {
-      oefmt::writeTum(aligned_path, result.aligned_estimate, {"estimate of " + paths[0] + " aligned to " + paths[1]});
+    if (!command.aligned_path.empty()) {
+      oefmt::writeTum(command.aligned_path, result.aligned_estimate,
+                      {"estimate of " + command.estimate + " aligned to " + command.truth});
     }
   } catch (const std::exception& e) {  // DatasetError, InputError (too few matches)
     std::fprintf(stderr, "oefmt_evaluate: %s\n", e.what());
@@ -165,31 +144,32 @@ int main(int argc, char** argv) {
     }
     return 1;
   }
-  if (!json_only) {
-    std::printf("%s vs %s\n%s", paths[0].c_str(), paths[1].c_str(), oefmt::evaluationTable(result, options).c_str());
+  if (!command.json_only) {
+    std::printf("%s vs %s\n%s", command.estimate.c_str(), command.truth.c_str(),
+                oefmt::evaluationTable(result, options).c_str());
   }
   std::printf("%s\n", oefmt::evaluationJson(result, options).c_str());
   std::fflush(stdout);
 
-  if (plot.empty()) return 0;
-  if (python.empty()) python = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-  if (script.empty()) script = defaultPlotScript();
-  const std::string data = plot + ".csv";
+  if (command.plot.empty()) return 0;
+  if (command.python.empty()) command.python = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+  if (command.script.empty()) command.script = defaultPlotScript();
+  const std::string data = command.plot + ".csv";
   try {
     writePlotData(data, result);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "oefmt_evaluate: %s\n", e.what());
     return 3;
   }
-  std::vector<std::string> command = {python, script, data, plot};
-  if (!title.empty()) command.insert(command.end(), {"--title", title});
-  const int status = run(command);
+  std::vector<std::string> plot_command = {command.python, command.script, data, command.plot};
+  if (!command.title.empty()) plot_command.insert(plot_command.end(), {"--title", command.title});
+  const int status = run(plot_command);
   std::remove(data.c_str());
   if (status != 0) {
     std::fprintf(stderr, "oefmt_evaluate: plotting failed (%s %s exited with %d); python3-matplotlib installed?\n",
-                 python.c_str(), script.c_str(), status);
+                 command.python.c_str(), command.script.c_str(), status);
     return 3;
   }
-  if (!json_only) std::printf("plot        %s\n", plot.c_str());
+  if (!command.json_only) std::printf("plot        %s\n", command.plot.c_str());
   return 0;
 }

@@ -30,36 +30,9 @@
 
 namespace {
 
-const char* const kUsage =
-    "usage: oefmt_offline (--images DIR | --bag FILE [--image-topic T] [--camera-info-topic T])\n"
-    "                     --output TRAJ.tum [--diagnostics FILE.csv] [--config FILE.yaml]\n"
-    "                     [--mode oefmt|efmt|fmt] [--altitude M] [--fx PX] [--no-undistort]\n"
-    "                     [--max-frames N] [--quiet]\n"
-    "\n"
-    "  --images DIR          a folder in the o-eFMT authors' layout (Images/, imageList.txt,\n"
-    "                        cam_param.yaml, optional timestamps.txt)\n"
-    "  --bag FILE            a ROS 1 bag with sensor_msgs/Image or CompressedImage\n"
-    "  --image-topic T       image topic in the bag (default: its only image topic)\n"
-    "  --camera-info-topic T CameraInfo topic (default: <image namespace>/camera_info if present;\n"
-    "                        '-' ignores intrinsics)\n"
-    "  --output FILE         trajectory, TUM 't x y z qx qy qz qw' (t: a folder's timestamps.txt\n"
-    "                        [s], or the frame index without a usable one; a bag's header\n"
-    "                        stamps [s]); REP-103 world: x right, y up of the first image, z up\n"
-    "  --diagnostics FILE    one CSV line per frame: registration, matching, optimizer, timing\n"
-    "  --config FILE         parameters (config/default.yaml documents every key)\n"
-    "  --mode M              overrides the config's mode\n"
-    "  --altitude M          altitude above the dominant plane at the first frame [m]: metric\n"
-    "                        output (otherwise units of the initial altitude)\n"
-    "  --fx PX               focal length of the images [px] (overrides cam_param/CameraInfo)\n"
-    "  --no-undistort        take the images as undistorted: ignore the lens distortion of\n"
-    "                        cam_param.yaml/CameraInfo (rectified images, or renders whose\n"
-    "                        cam_param.yaml is another camera's, as the o-eFMT authors' circle)\n"
-    "  --max-frames N        stop after N frames\n"
-    "  --quiet               no progress bar and no summary table\n"
-    "Exit status: 0 done, 1 an input could not be read (the trajectory so far is kept), 2 usage.\n";
-
 struct Options {
-  std::string images, bag, image_topic, camera_info_topic, output, diagnostics, config, mode;
+  std::string images, bag, image_topic, camera_info_topic, output, diagnostics, config;
+  std::optional<oefmt::EstimatorMode> mode;
   double altitude = -1.0;
   double fx = 0.0;
   long max_frames = -1;
@@ -67,44 +40,54 @@ struct Options {
   bool quiet = false;
 };
 
-[[noreturn]] void usageError(const std::string& message) {
-  std::fprintf(stderr, "oefmt_offline: %s\n\n%s", message.c_str(), kUsage);
-  std::exit(2);
-}
-
-Options parseArguments(int argc, char** argv) {
-  Options o;
-  oefmt::tools::Arguments args(argc, argv);
-  try {
-    while (!args.done()) {
-      const std::string arg = args.take();
-      const auto value = [&]() { return args.value(arg); };
-      if (arg == "--help" || arg == "-h") {
-        std::fputs(kUsage, stdout);
-        std::exit(0);
-      } else if (arg == "--images") o.images = value();
-      else if (arg == "--bag") o.bag = value();
-      else if (arg == "--image-topic") o.image_topic = value();
-      else if (arg == "--camera-info-topic") o.camera_info_topic = value();
-      else if (arg == "--output") o.output = value();
-      else if (arg == "--diagnostics") o.diagnostics = value();
-      else if (arg == "--config") o.config = value();
-      else if (arg == "--mode") o.mode = value();
-      else if (arg == "--altitude") o.altitude = args.number(arg);
-      else if (arg == "--fx") o.fx = args.number(arg);
-      else if (arg == "--no-undistort") o.undistort = false;
-      else if (arg == "--max-frames") o.max_frames = args.integer(arg);
-      else if (arg == "--quiet") o.quiet = true;
-      else usageError("unknown option '" + arg + "'");
-    }
-  } catch (const oefmt::InputError& e) {
-    usageError(e.what());
-  }
-  if (o.images.empty() == o.bag.empty()) usageError("give exactly one of --images and --bag");
-  if (o.output.empty()) usageError("--output is required");
-  if (o.altitude != -1.0 && !(o.altitude > 0.0)) usageError("--altitude must be > 0");
-  if (o.fx < 0.0) usageError("--fx must be > 0");
-  return o;
+/// Reads the command line into `o`; returns the exit status when the tool is to stop here.
+std::optional<int> parseArguments(int argc, char** argv, Options& o) {
+  CLI::App app(
+      "Runs the estimator over a dataset folder (--images) or a ROS bag (--bag) as fast as the CPU\n"
+      "allows and writes the trajectory, optional per-frame diagnostics and a summary.",
+      "oefmt_offline");
+  oefmt::tools::setUpTool(
+      app, "Exit status: 0 done, 1 an input could not be read (the trajectory so far is kept), 2 usage.");
+  app.add_option("--images", o.images,
+                 "a folder in the o-eFMT authors' layout (Images/, imageList.txt,\n"
+                 "cam_param.yaml, optional timestamps.txt)")
+      ->type_name("DIR");
+  app.add_option("--bag", o.bag, "a ROS 1 bag with sensor_msgs/Image or CompressedImage")->type_name("FILE");
+  app.add_option("--image-topic", o.image_topic, "image topic in the bag (default: its only image topic)")
+      ->type_name("T");
+  app.add_option("--camera-info-topic", o.camera_info_topic,
+                 "CameraInfo topic (default: <image namespace>/camera_info if present;\n'-' ignores intrinsics)")
+      ->type_name("T");
+  app.add_option("--output", o.output,
+                 "trajectory, TUM 't x y z qx qy qz qw' (t: a folder's timestamps.txt\n"
+                 "[s], or the frame index without a usable one; a bag's header\n"
+                 "stamps [s]); REP-103 world: x right, y up of the first image, z up")
+      ->type_name("FILE")
+      ->required();
+  app.add_option("--diagnostics", o.diagnostics, "one CSV line per frame: registration, matching, optimizer, timing")
+      ->type_name("FILE");
+  app.add_option("--config", o.config, "parameters (config/default.yaml documents every key)")->type_name("FILE");
+  app.add_option_function<std::string>(
+         "--mode", [&o](const std::string& mode) { o.mode = oefmt::parseEstimatorMode(mode); },
+         "overrides the config's mode")
+      ->type_name("oefmt|efmt|fmt");
+  oefmt::tools::addNumber(app, "--altitude", o.altitude, "M",
+                          "altitude above the dominant plane at the first frame [m]: metric\n"
+                          "output (otherwise units of the initial altitude)");
+  oefmt::tools::addNumber(app, "--fx", o.fx, "PX", "focal length of the images [px] (overrides cam_param/CameraInfo)");
+  app.add_flag_callback("--no-undistort", [&o] { o.undistort = false; },
+                        "take the images as undistorted: ignore the lens distortion of\n"
+                        "cam_param.yaml/CameraInfo (rectified images, or renders whose\n"
+                        "cam_param.yaml is another camera's, as the o-eFMT authors' circle)");
+  app.add_option("--max-frames", o.max_frames, "stop after N frames")->type_name("N");
+  app.add_flag("--quiet", o.quiet, "no progress bar and no summary table");
+  app.callback([&o] {
+    oefmt::requireInput(o.images.empty() != o.bag.empty(), "give exactly one of --images and --bag");
+    oefmt::requireInput(!o.output.empty(), "--output is required");
+    oefmt::requireInput(o.altitude == -1.0 || o.altitude > 0.0, "--altitude must be > 0");
+    oefmt::requireInput(o.fx >= 0.0, "--fx must be > 0");
+  });
+  return oefmt::tools::parseCommandLine(app, argc, argv);
 }
 
 void writeDiagnosticsHeader(std::ostream& out) {
@@ -145,7 +128,8 @@ double percentile(std::vector<double> values, double q) {
 
 int main(int argc, char** argv) {
   oefmt::useDefaultFftWisdom();
-  const Options options = parseArguments(argc, argv);
+  Options options;
+  if (const std::optional<int> exit_status = parseArguments(argc, argv, options)) return *exit_status;
   std::ofstream trajectory, diagnostics;
   long frames = 0, not_tracked = 0, restarts = 0, fallbacks = 0;
   std::vector<double> frame_ms;
@@ -155,7 +139,7 @@ int main(int argc, char** argv) {
   try {
     oefmt::EstimatorConfig config =
         options.config.empty() ? oefmt::EstimatorConfig{} : oefmt::loadConfig(options.config);
-    if (!options.mode.empty()) config.mode = oefmt::parseEstimatorMode(options.mode);
+    if (options.mode) config.mode = *options.mode;
     if (options.altitude > 0.0) config.altitude = options.altitude;
     config.validate();
 

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
+#include <vector>
 
-
+#include "command_line.h"
 #include "oefmt/error.h"
 #include "oefmt/io/image_decoding.h"
 #include "oefmt/registration/registration.h"
@@ -16,13 +18,6 @@
 #include "oefmt/io/fft_wisdom.h"
 
 namespace {
-
-void usage() {
-  std::puts(
-      "usage: oefmt_register_pair [--size N] [--classic] [OLDER_IMAGE NEWER_IMAGE]\n"
-      "Registers OLDER -> NEWER. Without images, registers a generated textured pair moved by\n"
-      "rotation 17 deg, zoom 1.06 and shift (12.5, -7.25) px and compares with that truth.");
-}
 
 int argmaxOf(const std::vector<float>& v) {
   int best = 0;
@@ -38,28 +33,19 @@ int main(int argc, char** argv) {
   oefmt::useDefaultFftWisdom();
   int size = 512;
   oefmt::RegistrationMethod method = oefmt::RegistrationMethod::kEnergyVectors;
-  std::vector<std::string> paths;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      usage();
-      return 0;
-    } else if (arg == "--classic") {
-      method = oefmt::RegistrationMethod::kClassic;
-    } else if (arg == "--size" && i + 1 < argc) {
-      size = std::atoi(argv[++i]);
-    } else if (!arg.empty() && arg[0] == '-') {
-      std::fprintf(stderr, "oefmt_register_pair: unknown option '%s'\n", arg.c_str());
-      usage();
-      return 2;
-    } else {
-      paths.push_back(arg);
-    }
-  }
-  if (!paths.empty() && paths.size() != 2) {
-    usage();
-    return 2;
-  }
+  std::string older_path, newer_path;
+  CLI::App app(
+      "Registers OLDER -> NEWER. Without images, registers a generated textured pair moved by\n"
+      "rotation 17 deg, zoom 1.06 and shift (12.5, -7.25) px and compares with that truth.",
+      "oefmt_register_pair");
+  oefmt::tools::setUpTool(app, "exit codes: 0 registered, 1 unreadable image, 2 invalid option, 3 registration failed");
+  app.add_option("--size", size, "working image size (default 512)")->type_name("N");
+  app.add_flag_callback("--classic", [&method] { method = oefmt::RegistrationMethod::kClassic; },
+                        "the classic Fourier-Mellin registration (single peaks, no energy vectors)");
+  app.add_option("OLDER_IMAGE", older_path, "the earlier image")->type_name("");
+  app.add_option("NEWER_IMAGE", newer_path, "the later image")->type_name("");
+  app.callback([&] { oefmt::requireInput(older_path.empty() == newer_path.empty(), "give two images or none"); });
+  if (const std::optional<int> exit_status = oefmt::tools::parseCommandLine(app, argc, argv)) return *exit_status;
   try {
     oefmt::RegistrationConfig config;
     config.size = size;
@@ -72,20 +58,19 @@ int main(int argc, char** argv) {
     truth.rotation = 17.0 * CV_PI / 180.0;
     truth.zoom = 1.06;
     truth.shift = {12.5, -7.25};
-    if (paths.empty()) {
+    if (older_path.empty()) {
       const cv::Mat1f texture = oefmt::sim::proceduralTexture({2048, 2048}, 1);
       older = oefmt::sim::renderView(texture, {1024, 1024}, {}, size);
       newer = oefmt::sim::renderView(texture, {1024, 1024}, truth, size);
       std::printf("generated pair: rotation %.3f deg, zoom %.4f, shift (%.2f, %.2f) px\n",
                   truth.rotation * 180.0 / CV_PI, truth.zoom, truth.shift.x, truth.shift.y);
     } else {
-      older = oefmt::readImageFile(paths[0]);
-      newer = oefmt::readImageFile(paths[1]);
-      for (int k = 0; k < 2; ++k) {
-        if ((k == 0 ? older : newer).empty()) {
-          std::fprintf(stderr, "oefmt_register_pair: cannot read image '%s'\n", paths[k].c_str());
-          return 1;
-        }
+      older = oefmt::readImageFile(older_path);
+      newer = oefmt::readImageFile(newer_path);
+      if (older.empty() || newer.empty()) {
+        std::fprintf(stderr, "oefmt_register_pair: cannot read image '%s'\n",
+                     (older.empty() ? older_path : newer_path).c_str());
+        return 1;
       }
     }
     const auto start = std::chrono::steady_clock::now();
@@ -108,7 +93,7 @@ int main(int argc, char** argv) {
                   argmaxOf(r.translation_energy) * registrar.shiftPerBin());
     }
     std::printf("time        %.2f ms (both frames analysed + registration, first call)\n", ms);
-    if (paths.empty()) {
+    if (older_path.empty()) {
       const double rotation_error = std::fabs(r.rotation - truth.rotation) * 180.0 / CV_PI;
       const double zoom_error = std::fabs(r.zoom / truth.zoom - 1.0) * 100.0;
       const double shift_error = std::hypot(r.translation.x - truth.shift.x, r.translation.y - truth.shift.y);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -22,87 +23,6 @@
 
 namespace {
 
-const char* const kUsage = R"(usage: oefmt_simulate [options] OUTPUT_DIR
-
-Renders a flight of a pinhole camera looking straight down at a textured ground plane with raised
-block tops at further heights (the last level's terraces inclined; optionally solid blocks with
-walls), and writes OUTPUT_DIR in the o-eFMT authors' layout: Images/0001.png..., imageList.txt,
-timestamps.txt (seconds), cam_param.yaml, plus groundtruth.tum (t x y z qx qy qz qw; world x
-east, y north, z up).
-Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames, 512x512).
-
-track:
-  --track circle|eight|line|spin
-                             shape (default circle); spin: no motion, the camera turns on the
-                             spot at the origin
-  --length M                 path length [m] (default circle 491, eight 880, line 200; not spin)
-  --frames N                 frames (default circle 200, eight 300, line 100, spin 100); loops
-                             repeat the first frame at the end
-  --altitude M               height above the ground [m] (default: from --overlap; spin 20)
-  --overlap F                target mean overlap of consecutive frames on the ground (0.78;
-                             not spin)
-  --climb M                  altitude change [m], negative for a descent (default 0; not spin)
-  --climb-profile ramp|hill  how a line changes altitude: ramp = linearly to altitude + climb
-                             (default), hill = smoothly to it half-way and back; loops: hill
-  --spin-rate DEG            yaw change per frame of a spin, either sign (default 6)
-  --heading fixed|track      yaw fixed, or following the direction of motion (default fixed)
-  --yaw DEG                  fixed yaw, or offset to the direction of motion (default 0)
-  --direction DEG            direction of a line track, from east counter-clockwise (default 0)
-camera:
-  --size PX                  width and height (default 512)
-  --width PX, --height PX
-  --fx PX, --fy PX           focal lengths (default: 60 deg horizontal field of view; fy = fx)
-  --cx PX, --cy PX           principal point (default: image centre)
-  --k1 K, --k2 K             radial distortion rendered and written to cam_param/CameraInfo
-                             (a barrel lens sees wider: without --altitude it flies lower)
-scene:
-  --seed N                   scene and noise seed (default 1)
-  --levels H1,H2,...         raised levels' heights [m] (default 0.15, 0.30 and 0.225 of the
-                             altitude)
-  --flat                     ground plane only, no raised levels
-  --incline DEG              tilt of the last level's terraces (default 6)
-  --raised F                 fraction of the terraces raised, split among the levels (1)
-  --fill F                   probability that a cell of a raised terrace has a top (0.8)
-  --cell M                   block pitch [m] (default 0.22 of the ground footprint's width at
-                             the mean altitude)
-  --texel M                  texture resolution [m] (default half a ground pixel at the mean
-                             altitude)
-  --texture-size N           procedural texture side [texels] (default 8 x width, <= 4096)
-  --texture LAYER=FILE       image file as texture of a layer (0 ground, 1.. levels); repeatable
-  --texture-style S[,S2,...] procedural texture per layer, ground first (the last one for the
-                             layers beyond the list): mixed (default: ground cells, level 1
-                             stripes, level 2 noise, ...), cells, stripes, noise, natural
-                             (photo-like, 1/f spectrum), brick, tiles (strictly periodic, about
-                             16 bricks or tiles per image width)
-  --contrast STD             rescale every texture to this grey std [grey levels of 255] around
-                             mid grey (default: as made); the summary prints the frames' std
-  --walls                    solid blocks: tops stand on the ground and their side walls are
-                             rendered (default: tops without walls)
-rendering and sensor:
-  --supersample N            N x N rays per pixel (default 2)
-  --noise SIGMA              Gaussian noise std, intensity 0..1 (default 0; 5 grey levels =
-                             0.0196)
-  --noise-grey SIGMA         the same in grey levels of 255 (= --noise SIGMA/255)
-  --brightness A             frame gain 1 + A sin(2 pi k / period) (default 0)
-  --brightness-period N      frames (default 50)
-  --flicker A                random gain per frame, uniform in [1 - A, 1 + A], times the sine's
-                             (default 0)
-  --threads N                rendering threads (default: all cores)
-time and output:
-  --rate HZ                  frame rate (default 5)
-  --start-time S             stamp of the first frame (default 1.0)
-  --bag FILE                 also write a ROS bag (sensor_msgs/Image + CameraInfo)
-  --bag-compression C        none, lz4 or bz2 (default none)
-  --image-topic T            (default /camera/image_raw)
-  --info-topic T             (default /camera/camera_info)
-  --frame-id F               (default camera_optical)
-  --quiet                    print nothing but errors
-  -h, --help
-exit codes: 0 success, 1 write failure, 2 invalid option)";
-
-using oefmt::tools::Arguments;
-using oefmt::tools::numberList;
-
 constexpr double kDeg = CV_PI / 180.0;
 
 struct Command {
@@ -112,182 +32,252 @@ struct Command {
   oefmt::BagWriterOptions bag_options;
   int threads = -1;
   bool quiet = false;
-  bool help = false;
 };
 
-Command parse(int argc, char** argv) {
-  Command command;
-  oefmt::sim::FlightOptions& f = command.flight;
-  bool length_set = false, frames_set = false, overlap_set = false, spin_rate_set = false,
-       profile_set = false;
-  Arguments args(argc, argv);
-  while (!args.done()) {
-    const std::string arg = args.take();
-    if (arg == "-h" || arg == "--help") {
-      command.help = true;
-      return command;
-    } else if (arg == "--track") {
-      f.track.shape = oefmt::sim::trackShapeFromString(args.value(arg));
-    } else if (arg == "--length") {
-      f.track.length = args.number(arg);
-      length_set = true;
-    } else if (arg == "--frames") {
-      f.track.frames = args.integer(arg);
-      frames_set = true;
-    } else if (arg == "--altitude") {
-      f.track.altitude = args.number(arg);
-      if (!(f.track.altitude > 0.0)) throw oefmt::InputError("--altitude must be > 0");
-    } else if (arg == "--overlap") {
-      f.overlap = args.number(arg);
-      overlap_set = true;
-    } else if (arg == "--climb") {
-      f.track.climb = args.number(arg);
-    } else if (arg == "--climb-profile") {
-      const std::string profile = args.value(arg);
-      if (profile != "ramp" && profile != "hill") throw oefmt::InputError("--climb-profile must be ramp or hill");
-      f.track.climb_profile = profile == "ramp" ? oefmt::sim::ClimbProfile::kRamp : oefmt::sim::ClimbProfile::kHill;
-      profile_set = true;
-    } else if (arg == "--spin-rate") {
-      f.track.spin_rate = args.number(arg) * kDeg;
-      if (!(std::fabs(f.track.spin_rate) < CV_PI)) throw oefmt::InputError("--spin-rate must be in (-180, 180) deg");
-      spin_rate_set = true;
-    } else if (arg == "--heading") {
-      const std::string mode = args.value(arg);
-      if (mode != "fixed" && mode != "track") throw oefmt::InputError("--heading must be fixed or track");
-      f.track.heading = mode == "fixed" ? oefmt::sim::HeadingMode::kFixed : oefmt::sim::HeadingMode::kTrack;
-    } else if (arg == "--yaw") {
-      f.track.yaw = args.number(arg) * kDeg;
-    } else if (arg == "--direction") {
-      f.track.line_direction = args.number(arg) * kDeg;
-    } else if (arg == "--size") {
-      f.width = f.height = args.integer(arg);
-    } else if (arg == "--width") {
-      f.width = args.integer(arg);
-    } else if (arg == "--height") {
-      f.height = args.integer(arg);
-    } else if (arg == "--fx") {
-      f.fx = args.number(arg);
-    } else if (arg == "--fy") {
-      f.fy = args.number(arg);
-    } else if (arg == "--cx") {
-      f.cx = args.number(arg);
-    } else if (arg == "--cy") {
-      f.cy = args.number(arg);
-    } else if (arg == "--k1") {
-      f.distortion.k1 = args.number(arg);
-    } else if (arg == "--k2") {
-      f.distortion.k2 = args.number(arg);
-    } else if (arg == "--seed") {
-      const int seed = args.integer(arg);
-      if (seed < 0) throw oefmt::InputError("--seed must be >= 0");
-      f.seed = static_cast<std::uint32_t>(seed);
-    } else if (arg == "--levels") {
-      f.level_heights = numberList(arg, args.value(arg));
-    } else if (arg == "--flat") {
-      f.flat = true;
-    } else if (arg == "--incline") {
-      f.incline_deg = args.number(arg);
-    } else if (arg == "--raised") {
-      f.raised_share = args.number(arg);
-    } else if (arg == "--fill") {
-      f.fill = args.number(arg);
-    } else if (arg == "--cell") {
-      f.cell_size = args.number(arg);
-    } else if (arg == "--texel") {
-      f.texel = args.number(arg);
-    } else if (arg == "--texture-size") {
-      f.texture_size = args.integer(arg);
-    } else if (arg == "--texture") {
-      const std::string text = args.value(arg);
-      const auto equals = text.find('=');
-      char* end = nullptr;
-      const long layer = equals == std::string::npos ? -1 : std::strtol(text.c_str(), &end, 10);
-      if (layer < 0 || layer > 16 || end != text.c_str() + equals || equals + 1 >= text.size()) {
-        throw oefmt::InputError("--texture needs LAYER=FILE with LAYER 0 (ground), 1, 2, ...");
-      }
-      if (f.texture_files.size() <= static_cast<std::size_t>(layer)) f.texture_files.resize(layer + 1);
-      f.texture_files[layer] = text.substr(equals + 1);
-    } else if (arg == "--texture-style") {
-      f.texture_styles.clear();
-      std::stringstream list(args.value(arg));
-      std::string name;
-      while (std::getline(list, name, ',')) {
-        try {
-          f.texture_styles.push_back(oefmt::sim::textureStyleFromString(name));
-        } catch (const oefmt::InputError& e) {
-          throw oefmt::InputError(std::string("--texture-style: ") + e.what());
-        }
-      }
-      if (f.texture_styles.empty()) throw oefmt::InputError("--texture-style needs a style");
-    } else if (arg == "--contrast") {
-      f.contrast = args.number(arg);
-      if (!(f.contrast > 0.0 && f.contrast <= 127.5)) throw oefmt::InputError("--contrast must be in (0, 127.5] grey levels");
-    } else if (arg == "--walls") {
-      f.walls = true;
-    } else if (arg == "--supersample") {
-      f.supersample = args.integer(arg);
-    } else if (arg == "--noise") {
-      f.sensor.noise = args.number(arg);
-    } else if (arg == "--noise-grey") {
-      f.sensor.noise = args.number(arg) / 255.0;
-      if (!(f.sensor.noise >= 0.0)) throw oefmt::InputError("--noise-grey must be >= 0");
-    } else if (arg == "--brightness") {
-      f.sensor.brightness = args.number(arg);
-    } else if (arg == "--brightness-period") {
-      f.sensor.brightness_period = args.number(arg);
-    } else if (arg == "--flicker") {
-      f.sensor.flicker = args.number(arg);
-      if (!(f.sensor.flicker >= 0.0 && f.sensor.flicker < 1.0)) throw oefmt::InputError("--flicker must be in [0, 1)");
-    } else if (arg == "--threads") {
-      command.threads = args.integer(arg);
-      if (command.threads < 1) throw oefmt::InputError("--threads must be >= 1");
-    } else if (arg == "--rate") {
-      f.rate = args.number(arg);
-    } else if (arg == "--start-time") {
-      f.start_time = args.number(arg);
-    } else if (arg == "--bag") {
-      command.bag = args.value(arg);
-    } else if (arg == "--bag-compression") {
-      command.bag_options.compression = args.value(arg);
-    } else if (arg == "--image-topic") {
-      command.bag_options.image_topic = args.value(arg);
-    } else if (arg == "--info-topic") {
-      command.bag_options.camera_info_topic = args.value(arg);
-    } else if (arg == "--frame-id") {
-      command.bag_options.frame_id = args.value(arg);
-    } else if (arg == "--quiet") {
-      command.quiet = true;
-    } else if (!arg.empty() && arg[0] == '-') {
-      throw oefmt::InputError("unknown option '" + arg + "' (see --help)");
-    } else if (command.output.empty()) {
-      command.output = arg;
-    } else {
-      throw oefmt::InputError("more than one output folder given ('" + command.output + "', '" + arg + "')");
+/// LAYER=FILE of --texture into the flight's texture files.
+void addTextureFile(oefmt::sim::FlightOptions& f, const std::string& text) {
+  const auto equals = text.find('=');
+  char* end = nullptr;
+  const long layer = equals == std::string::npos ? -1 : std::strtol(text.c_str(), &end, 10);
+  if (layer < 0 || layer > 16 || end != text.c_str() + equals || equals + 1 >= text.size()) {
+    throw oefmt::InputError("--texture needs LAYER=FILE with LAYER 0 (ground), 1, 2, ...");
+  }
+  if (f.texture_files.size() <= static_cast<std::size_t>(layer)) f.texture_files.resize(layer + 1);
+  f.texture_files[layer] = text.substr(equals + 1);
+}
+
+/// S[,S2,...] of --texture-style.
+std::vector<oefmt::sim::TextureStyle> textureStyles(const std::string& text) {
+  std::vector<oefmt::sim::TextureStyle> styles;
+  std::stringstream list(text);
+  std::string name;
+  while (std::getline(list, name, ',')) {
+    try {
+      styles.push_back(oefmt::sim::textureStyleFromString(name));
+    } catch (const oefmt::InputError& e) {
+      throw oefmt::InputError(std::string("--texture-style: ") + e.what());
     }
   }
-  if (command.output.empty()) throw oefmt::InputError("no OUTPUT_DIR given (see --help)");
+  if (styles.empty()) throw oefmt::InputError("--texture-style needs a style");
+  return styles;
+}
+
+/// What a flight's options leave to its track, and the checks that span several options.
+void completeTrack(oefmt::sim::FlightOptions& f, bool length_set, bool frames_set, bool overlap_set,
+                   bool spin_rate_set, bool profile_set) {
+  using oefmt::requireInput;
   using oefmt::sim::TrackShape;
   const TrackShape shape = f.track.shape;
   if (shape == TrackShape::kSpin) {
-    if (length_set) throw oefmt::InputError("--length does not apply to --track spin (the camera stays at the origin)");
-    if (overlap_set) {
-      throw oefmt::InputError("--overlap does not apply to --track spin (the camera does not move): give --altitude "
-                              "(default 20 m)");
-    }
-    if (f.track.climb != 0.0) throw oefmt::InputError("--climb does not apply to --track spin");
-    if (profile_set) throw oefmt::InputError("--climb-profile does not apply to --track spin");
-    if (f.track.heading == oefmt::sim::HeadingMode::kTrack) {
-      throw oefmt::InputError("--heading track needs a moving track, not spin");
-    }
-  } else if (spin_rate_set) {
-    throw oefmt::InputError("--spin-rate applies to --track spin only");
+    requireInput(!length_set, "--length does not apply to --track spin (the camera stays at the origin)");
+    requireInput(!overlap_set,
+                 "--overlap does not apply to --track spin (the camera does not move): give --altitude "
+                 "(default 20 m)");
+    requireInput(f.track.climb == 0.0, "--climb does not apply to --track spin");
+    requireInput(!profile_set, "--climb-profile does not apply to --track spin");
+    requireInput(f.track.heading != oefmt::sim::HeadingMode::kTrack, "--heading track needs a moving track, not spin");
+  } else {
+    requireInput(!spin_rate_set, "--spin-rate applies to --track spin only");
   }
-  if (profile_set && f.track.climb_profile == oefmt::sim::ClimbProfile::kRamp && shape != TrackShape::kLine) {
-    throw oefmt::InputError("--climb-profile ramp needs --track line (a loop comes back to its start: hill)");
-  }
+  requireInput(!(profile_set && f.track.climb_profile == oefmt::sim::ClimbProfile::kRamp && shape != TrackShape::kLine),
+               "--climb-profile ramp needs --track line (a loop comes back to its start: hill)");
   if (!length_set) f.track.length = shape == TrackShape::kEight ? 880.0 : shape == TrackShape::kLine ? 200.0 : shape == TrackShape::kSpin ? 0.0 : 491.0;
   if (!frames_set) f.track.frames = shape == TrackShape::kEight ? 300 : shape == TrackShape::kCircle ? 200 : 100;
-  return command;
+}
+
+/// Reads the command line into `command`; returns the exit status when the tool is to stop here.
+std::optional<int> parse(int argc, char** argv, Command& command) {
+  using oefmt::requireInput;
+  using oefmt::tools::addChoice;
+  using oefmt::tools::addNumber;
+  CLI::App app(R"(Renders a flight of a pinhole camera looking straight down at a textured ground plane with raised
+block tops at further heights (the last level's terraces inclined; optionally solid blocks with
+walls), and writes OUTPUT_DIR in the o-eFMT authors' layout: Images/0001.png..., imageList.txt,
+timestamps.txt (seconds), cam_param.yaml, plus groundtruth.tum (t x y z qx qy qz qw; world x
+east, y north, z up).
+Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames, 512x512).)",
+               "oefmt_simulate");
+  oefmt::tools::setUpTool(app, "exit codes: 0 success, 1 write failure, 2 invalid option");
+  oefmt::sim::FlightOptions& f = command.flight;
+  // An angle option in degrees, kept in radians.
+  const auto addAngle = [&app](const std::string& name, double& radians, const std::string& help) {
+    return app.add_option_function<double>(name, [&radians](double degrees) { radians = degrees * kDeg; }, help)
+        ->type_name("DEG")
+        ->check(oefmt::tools::finite());
+  };
+
+  app.add_option("OUTPUT_DIR", command.output, "the flight's folder")->type_name("")->required();
+
+  const std::string track = "track";
+  app.add_option_function<std::string>(
+         "--track", [&f](const std::string& name) { f.track.shape = oefmt::sim::trackShapeFromString(name); },
+         "shape (default circle); spin: no motion, the camera turns on the\nspot at the origin")
+      ->type_name("circle|eight|line|spin")
+      ->group(track);
+  const CLI::Option* length =
+      addNumber(app, "--length", f.track.length, "M",
+                "path length [m] (default circle 491, eight 880, line 200; not spin)")
+          ->group(track);
+  const CLI::Option* frames =
+      app.add_option("--frames", f.track.frames,
+                     "frames (default circle 200, eight 300, line 100, spin 100); loops\n"
+                     "repeat the first frame at the end")
+          ->type_name("N")
+          ->group(track);
+  addNumber(app, "--altitude", f.track.altitude, "M", "height above the ground [m] (default: from --overlap; spin 20)")
+      ->group(track);
+  const CLI::Option* overlap =
+      addNumber(app, "--overlap", f.overlap, "F",
+                "target mean overlap of consecutive frames on the ground (0.78;\nnot spin)")
+          ->group(track);
+  addNumber(app, "--climb", f.track.climb, "M", "altitude change [m], negative for a descent (default 0; not spin)")
+      ->group(track);
+  const CLI::Option* profile =
+      addChoice(app, "--climb-profile", f.track.climb_profile,
+                {{"ramp", oefmt::sim::ClimbProfile::kRamp}, {"hill", oefmt::sim::ClimbProfile::kHill}},
+                "how a line changes altitude: ramp = linearly to altitude + climb\n"
+                "(default), hill = smoothly to it half-way and back; loops: hill")
+          ->group(track);
+  const CLI::Option* spin_rate =
+      addAngle("--spin-rate", f.track.spin_rate, "yaw change per frame of a spin, either sign (default 6)")
+          ->group(track);
+  addChoice(app, "--heading", f.track.heading,
+            {{"fixed", oefmt::sim::HeadingMode::kFixed}, {"track", oefmt::sim::HeadingMode::kTrack}},
+            "yaw fixed, or following the direction of motion (default fixed)")
+      ->group(track);
+  addAngle("--yaw", f.track.yaw, "fixed yaw, or offset to the direction of motion (default 0)")->group(track);
+  addAngle("--direction", f.track.line_direction, "direction of a line track, from east counter-clockwise (default 0)")
+      ->group(track);
+
+  // Later options override earlier ones (--size 256 --width 320): these run as they are read.
+  const std::string camera = "camera";
+  app.add_option_function<int>(
+         "--size", [&f](int size) { f.width = f.height = size; }, "width and height (default 512)")
+      ->type_name("PX")
+      ->trigger_on_parse()
+      ->group(camera);
+  app.add_option("--width", f.width, "image width")->type_name("PX")->trigger_on_parse()->group(camera);
+  app.add_option("--height", f.height, "image height")->type_name("PX")->trigger_on_parse()->group(camera);
+  addNumber(app, "--fx", f.fx, "PX", "focal length (default: 60 deg horizontal field of view)")->group(camera);
+  addNumber(app, "--fy", f.fy, "PX", "focal length (default: fx)")->group(camera);
+  addNumber(app, "--cx", f.cx, "PX", "principal point (default: image centre)")->group(camera);
+  addNumber(app, "--cy", f.cy, "PX", "principal point (default: image centre)")->group(camera);
+  addNumber(app, "--k1", f.distortion.k1, "K",
+            "radial distortion rendered and written to cam_param/CameraInfo\n"
+            "(a barrel lens sees wider: without --altitude it flies lower)")
+      ->group(camera);
+  addNumber(app, "--k2", f.distortion.k2, "K", "the same, second coefficient")->group(camera);
+
+  const std::string scene = "scene";
+  app.add_option_function<int>(
+         "--seed",
+         [&f](int seed) {
+           requireInput(seed >= 0, "--seed must be >= 0");
+           f.seed = static_cast<std::uint32_t>(seed);
+         },
+         "scene and noise seed (default 1)")
+      ->type_name("N")
+      ->group(scene);
+  oefmt::tools::addNumberList(app, "--levels", f.level_heights, "H1,H2,...",
+                              "raised levels' heights [m] (default 0.15, 0.30 and 0.225 of the\naltitude)")
+      ->group(scene);
+  app.add_flag("--flat", f.flat, "ground plane only, no raised levels")->group(scene);
+  addNumber(app, "--incline", f.incline_deg, "DEG", "tilt of the last level's terraces (default 6)")->group(scene);
+  addNumber(app, "--raised", f.raised_share, "F", "fraction of the terraces raised, split among the levels (1)")
+      ->group(scene);
+  addNumber(app, "--fill", f.fill, "F", "probability that a cell of a raised terrace has a top (0.8)")->group(scene);
+  addNumber(app, "--cell", f.cell_size, "M",
+            "block pitch [m] (default 0.22 of the ground footprint's width at\nthe mean altitude)")
+      ->group(scene);
+  addNumber(app, "--texel", f.texel, "M",
+            "texture resolution [m] (default half a ground pixel at the mean\naltitude)")
+      ->group(scene);
+  app.add_option("--texture-size", f.texture_size, "procedural texture side [texels] (default 8 x width, <= 4096)")
+      ->type_name("N")
+      ->group(scene);
+  app.add_option_function<std::vector<std::string>>(
+         "--texture",
+         [&f](const std::vector<std::string>& specs) {
+           for (const std::string& spec : specs) addTextureFile(f, spec);
+         },
+         "image file as texture of a layer (0 ground, 1.. levels); repeatable")
+      ->type_name("LAYER=FILE")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->group(scene);
+  app.add_option_function<std::string>(
+         "--texture-style", [&f](const std::string& text) { f.texture_styles = textureStyles(text); },
+         "procedural texture per layer, ground first (the last one for the\n"
+         "layers beyond the list): mixed (default: ground cells, level 1\n"
+         "stripes, level 2 noise, ...), cells, stripes, noise, natural\n"
+         "(photo-like, 1/f spectrum), brick, tiles (strictly periodic, about\n"
+         "16 bricks or tiles per image width)")
+      ->type_name("S[,S2,...]")
+      ->group(scene);
+  addNumber(app, "--contrast", f.contrast, "STD",
+            "rescale every texture to this grey std [grey levels of 255] around\n"
+            "mid grey (default: as made); the summary prints the frames' std")
+      ->group(scene);
+  app.add_flag("--walls", f.walls,
+               "solid blocks: tops stand on the ground and their side walls are\n"
+               "rendered (default: tops without walls)")
+      ->group(scene);
+
+  // --noise and --noise-grey set the same value: the later one counts.
+  const std::string sensor = "rendering and sensor";
+  app.add_option("--supersample", f.supersample, "N x N rays per pixel (default 2)")->type_name("N")->group(sensor);
+  addNumber(app, "--noise", f.sensor.noise, "SIGMA",
+            "Gaussian noise std, intensity 0..1 (default 0; 5 grey levels =\n0.0196)")
+      ->trigger_on_parse()
+      ->group(sensor);
+  app.add_option_function<double>(
+         "--noise-grey",
+         [&f](double grey) {
+           f.sensor.noise = grey / 255.0;
+           requireInput(f.sensor.noise >= 0.0, "--noise-grey must be >= 0");
+         },
+         "the same in grey levels of 255 (= --noise SIGMA/255)")
+      ->type_name("SIGMA")
+      ->check(oefmt::tools::finite())
+      ->trigger_on_parse()
+      ->group(sensor);
+  addNumber(app, "--brightness", f.sensor.brightness, "A", "frame gain 1 + A sin(2 pi k / period) (default 0)")
+      ->group(sensor);
+  addNumber(app, "--brightness-period", f.sensor.brightness_period, "N", "frames (default 50)")->group(sensor);
+  addNumber(app, "--flicker", f.sensor.flicker, "A",
+            "random gain per frame, uniform in [1 - A, 1 + A], times the sine's\n(default 0)")
+      ->group(sensor);
+  app.add_option("--threads", command.threads, "rendering threads (default: all cores)")->type_name("N")->group(sensor);
+
+  const std::string output = "time and output";
+  addNumber(app, "--rate", f.rate, "HZ", "frame rate (default 5)")->group(output);
+  addNumber(app, "--start-time", f.start_time, "S", "stamp of the first frame (default 1.0)")->group(output);
+  app.add_option("--bag", command.bag, "also write a ROS bag (sensor_msgs/Image + CameraInfo)")
+      ->type_name("FILE")
+      ->group(output);
+  addChoice(app, "--bag-compression", command.bag_options.compression, {"none", "lz4", "bz2"},
+            "bag chunk compression (default none)")
+      ->group(output);
+  app.add_option("--image-topic", command.bag_options.image_topic, "(default /camera/image_raw)")
+      ->type_name("T")
+      ->group(output);
+  app.add_option("--info-topic", command.bag_options.camera_info_topic, "(default /camera/camera_info)")
+      ->type_name("T")
+      ->group(output);
+  app.add_option("--frame-id", command.bag_options.frame_id, "(default camera_optical)")->type_name("F")->group(output);
+  app.add_flag("--quiet", command.quiet, "print nothing but errors")->group(output);
+
+  app.callback([&] {
+    const bool given_altitude = app.count("--altitude") > 0;
+    requireInput(!given_altitude || f.track.altitude > 0.0, "--altitude must be > 0");
+    requireInput(std::fabs(f.track.spin_rate) < CV_PI, "--spin-rate must be in (-180, 180) deg");
+    requireInput(app.count("--contrast") == 0 || (f.contrast > 0.0 && f.contrast <= 127.5),
+                 "--contrast must be in (0, 127.5] grey levels");
+    requireInput(f.sensor.flicker >= 0.0 && f.sensor.flicker < 1.0, "--flicker must be in [0, 1)");
+    requireInput(app.count("--threads") == 0 || command.threads >= 1, "--threads must be >= 1");
+    completeTrack(f, length->count() > 0, frames->count() > 0, overlap->count() > 0, spin_rate->count() > 0,
+                  profile->count() > 0);
+  });
+  return oefmt::tools::parseCommandLine(app, argc, argv);
 }
 
 void printTextures(const oefmt::sim::SceneConfig& scene) {
@@ -356,16 +346,7 @@ void printPlan(const oefmt::sim::FlightPlan& plan, const Command& command) {
 
 int main(int argc, char** argv) {
   Command command;
-  try {
-    command = parse(argc, argv);
-  } catch (const oefmt::InputError& e) {
-    std::fprintf(stderr, "oefmt_simulate: %s\n", e.what());
-    return 2;
-  }
-  if (command.help) {
-    std::puts(kUsage);
-    return 0;
-  }
+  if (const std::optional<int> exit_status = parse(argc, argv, command)) return *exit_status;
   if (command.threads > 0) cv::setNumThreads(command.threads);
   const auto start = std::chrono::steady_clock::now();
   try {

@@ -96,6 +96,14 @@ TEST(Tools, SimulateCorpusOptions) {
   EXPECT_NE(result.out.find("grey std    of the written frames: mean "), std::string::npos) << result.out;
   EXPECT_EQ(FolderDataset(dir / "varied").size(), 3u);
 
+  // Options are read in order: the later of --size and --width, and of a repeated option, counts.
+  result = run(dir, simulate + "--width 80 --size 64 --height 72 --frames 4 --noise-grey 5 --noise 0 --track spin " +
+                        (dir / "ordered"));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_NE(result.out.find("camera      64x72,"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("spin at the origin, 4 frames"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("sensor      noise 0 "), std::string::npos) << result.out;
+
   result = run(dir, simulate + "--track spin --spin-rate -10 " + (dir / "spin"));
   ASSERT_EQ(result.status, 0) << result.err;
   EXPECT_NE(result.out.find("spin at the origin, 3 frames, yaw 0.0 deg turning -10.00 deg per frame"),
@@ -109,7 +117,7 @@ TEST(Tools, SimulateCorpusOptions) {
       {"--spin-rate 5", "--spin-rate applies to --track spin only"},
       {"--track spin --spin-rate 200", "--spin-rate must be in (-180, 180) deg"},
       {"--climb-profile ramp", "--climb-profile ramp needs --track line"},
-      {"--climb-profile up", "--climb-profile must be ramp or hill"},
+      {"--climb-profile up", "--climb-profile: up not in {ramp,hill}"},
       {"--texture-style cells,marble", "--texture-style: unknown texture style 'marble'"},
       {"--contrast 0", "--contrast must be in (0, 127.5]"},
       {"--flicker 1", "--flicker must be in [0, 1)"},
@@ -135,7 +143,7 @@ TEST(Tools, ExitCodesAndMessages) {
   EXPECT_NE(bad.err.find("unknown track 'square'"), std::string::npos) << bad.err;
   bad = run(dir, std::string(OEFMT_SIMULATE) + " --frames");
   EXPECT_EQ(bad.status, 2);
-  EXPECT_NE(bad.err.find("needs a value"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("--frames: 1 required N missing"), std::string::npos) << bad.err;
 
   bad = run(dir, std::string(OEFMT_FOLDER_TO_BAG) + " " + (dir / "missing") + " " + (dir / "out.bag"));
   EXPECT_EQ(bad.status, 1);
@@ -149,6 +157,25 @@ TEST(Tools, ExitCodesAndMessages) {
   const ToolRun by_index = run(dir, std::string(OEFMT_EVALUATE) + " --match index " + (dir / "a.tum") + " " + (dir / "b.tum"));
   EXPECT_EQ(by_index.status, 0) << by_index.err;
   EXPECT_EQ(run(dir, std::string(OEFMT_EVALUATE) + " --tolerance x a b").status, 2);
+  EXPECT_EQ(run(dir, std::string(OEFMT_EVALUATE) + " --match frame a b").status, 2);
+
+  const ToolRun help = run(dir, std::string(OEFMT_OFFLINE) + " --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("--mode oefmt|efmt|fmt"), std::string::npos) << help.out;
+  const std::pair<std::string, std::string> offline_bad[] = {
+      {"--output x.tum", "give exactly one of --images and --bag"},
+      {"--images a --bag b --output x.tum", "give exactly one of --images and --bag"},
+      {"--images a", "--output is required"},
+      {"--images a --output x.tum --mode slow", "unknown mode 'slow'"},
+      {"--images a --output x.tum --altitude 0", "--altitude must be > 0"},
+      {"--images a --output x.tum --max-frames ten", "--max-frames"},
+      {"--images a --output x.tum --frames 3", "--frames"},
+  };
+  for (const auto& [options, message] : offline_bad) {
+    bad = run(dir, std::string(OEFMT_OFFLINE) + " " + options);
+    EXPECT_EQ(bad.status, 2) << options;
+    EXPECT_NE(bad.err.find(message), std::string::npos) << options << ": " << bad.err;
+  }
 }
 
 }  // namespace
