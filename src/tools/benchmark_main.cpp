@@ -39,6 +39,7 @@ struct Inputs {
   std::shared_ptr<const oefmt::SpectralContext> context;
   cv::Mat older_raw, newer_raw;
   oefmt::PreparedImage older, newer, shifted;
+  oefmt::FrameSpectra older_spectra, newer_spectra;  // of older and newer
   std::vector<std::uint8_t> older_png;  // older_raw as a PNG file's bytes
 
   Inputs() {
@@ -58,6 +59,9 @@ struct Inputs {
     oefmt::sim::ViewMotion shift_only;
     shift_only.shift = {14.0, -9.0};
     shifted = oefmt::prepareImage(toBgr(oefmt::sim::renderView(texture, {1024, 1024}, shift_only, kN)), kN);
+    oefmt::SpectraBuilder builder(context);
+    older_spectra = builder.build(older);
+    newer_spectra = builder.build(newer);
   }
 
   static cv::Mat toBgr(const cv::Mat1f& grey) {
@@ -237,9 +241,8 @@ BENCHMARK(BM_Stage_WindowAndForwardFft)->Arg(0)->Arg(1)->Unit(benchmark::kMicros
 // A cross power, then its inverse transform. Argument 0: in place (what runs); 1: out of place.
 void BM_Stage_CrossPowerAndInverseFft(benchmark::State& state) {
   const oefmt::Fft2d& fft = inputs().context->fft();
-  oefmt::SpectraBuilder builder(inputs().context);
-  const oefmt::FrameSpectra a = builder.build(inputs().older);
-  const oefmt::FrameSpectra b = builder.build(inputs().newer);
+  const oefmt::FrameSpectra& a = inputs().older_spectra;
+  const oefmt::FrameSpectra& b = inputs().newer_spectra;
   cv::Mat2f cross_power;
   cv::Mat1f image;
   for (auto _ : state) {
@@ -268,9 +271,8 @@ BENCHMARK(BM_Stage_MagnitudeAndLogPolar)->Unit(benchmark::kMicrosecond);
 
 // The cross power the registrations compute (fftshift and 1/N^2 folded in).
 void BM_Stage_CrossPower(benchmark::State& state) {
-  oefmt::SpectraBuilder builder(inputs().context);
-  const oefmt::FrameSpectra a = builder.build(inputs().older);
-  const oefmt::FrameSpectra b = builder.build(inputs().newer);
+  const oefmt::FrameSpectra& a = inputs().older_spectra;
+  const oefmt::FrameSpectra& b = inputs().newer_spectra;
   cv::Mat2f cross_power;
   for (auto _ : state) {
     oefmt::centredCrossPower(b.spectrum, a.spectrum, cross_power);
@@ -280,9 +282,8 @@ void BM_Stage_CrossPower(benchmark::State& state) {
 BENCHMARK(BM_Stage_CrossPower)->Unit(benchmark::kMicrosecond);
 
 void BM_Stage_HalfTurnTest(benchmark::State& state) {
-  oefmt::SpectraBuilder builder(inputs().context);
-  const oefmt::FrameSpectra a = builder.build(inputs().older);
-  const oefmt::FrameSpectra b = builder.build(inputs().newer);
+  const oefmt::FrameSpectra& a = inputs().older_spectra;
+  const oefmt::FrameSpectra& b = inputs().newer_spectra;
   cv::Mat2f spectrum;
   cv::Mat1f surface;
   for (auto _ : state) {

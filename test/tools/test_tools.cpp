@@ -49,6 +49,18 @@ ToolRun run(const TempDir& dir, const std::string& command) {
   return result;
 }
 
+// Runs `command` + OPTIONS + `last` for each {OPTIONS, MESSAGE}: exit status 2 (a bad command
+// line) and one line on stderr that says MESSAGE.
+void expectUsageErrors(const TempDir& dir, const std::string& command, const std::string& last,
+                       const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (const auto& [options, message] : cases) {
+    const ToolRun result = run(dir, command + options + last);
+    EXPECT_EQ(result.status, 2) << options;
+    EXPECT_NE(result.err.find(message), std::string::npos) << options << ": " << result.err;
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+  }
+}
+
 // A 3-frame 128 x 128 flight in dir/flight (PNG images, ground truth, cam_param.yaml).
 void simulateThreeFrames(const TempDir& dir) {
   const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --frames 3 --length 5 --seed 4 " +
@@ -110,7 +122,7 @@ TEST(Tools, SimulateCorpusOptions) {
             std::string::npos) << result.out;
   EXPECT_NE(result.out.find("altitude    20.000 m"), std::string::npos) << result.out;
 
-  const std::pair<std::string, std::string> bad[] = {
+  expectUsageErrors(dir, simulate, " " + (dir / "bad"), {
       {"--track spin --overlap 0.8", "--overlap does not apply to --track spin"},
       {"--track spin --length 10", "--length does not apply to --track spin"},
       {"--track spin --climb 2", "--climb does not apply to --track spin"},
@@ -123,13 +135,7 @@ TEST(Tools, SimulateCorpusOptions) {
       {"--flicker 1", "--flicker must be in [0, 1)"},
       {"--noise-grey -1", "--noise-grey must be >= 0"},
       {"--track line --altitude 10 --climb -8", "descend less"},
-  };
-  for (const auto& [options, message] : bad) {
-    result = run(dir, simulate + options + " " + (dir / "bad"));
-    EXPECT_EQ(result.status, 2) << options;
-    EXPECT_NE(result.err.find(message), std::string::npos) << options << ": " << result.err;
-    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
-  }
+  });
 }
 
 TEST(Tools, ExitCodesAndMessages) {
@@ -162,7 +168,7 @@ TEST(Tools, ExitCodesAndMessages) {
   const ToolRun help = run(dir, std::string(OEFMT_OFFLINE) + " --help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("--mode oefmt|efmt|fmt"), std::string::npos) << help.out;
-  const std::pair<std::string, std::string> offline_bad[] = {
+  expectUsageErrors(dir, std::string(OEFMT_OFFLINE) + " ", "", {
       {"--output x.tum", "give exactly one of --images and --bag"},
       {"--images a --bag b --output x.tum", "give exactly one of --images and --bag"},
       {"--images a", "--output is required"},
@@ -170,12 +176,7 @@ TEST(Tools, ExitCodesAndMessages) {
       {"--images a --output x.tum --altitude 0", "--altitude must be > 0"},
       {"--images a --output x.tum --max-frames ten", "--max-frames"},
       {"--images a --output x.tum --frames 3", "--frames"},
-  };
-  for (const auto& [options, message] : offline_bad) {
-    bad = run(dir, std::string(OEFMT_OFFLINE) + " " + options);
-    EXPECT_EQ(bad.status, 2) << options;
-    EXPECT_NE(bad.err.find(message), std::string::npos) << options << ": " << bad.err;
-  }
+  });
 }
 
 }  // namespace
