@@ -35,20 +35,12 @@ target_link_libraries(oefmt_estimation PUBLIC oefmt_registration Eigen3::Eigen C
 target_sources(oefmt_estimation PRIVATE ${OEFMT_ROOT}/src/io/yaml_map.cpp ${OEFMT_ROOT}/src/io/yaml_text.cpp)
 
 oefmt_layer_library(oefmt_io io)
-# Not imgcodecs: io loads it on first use (see the plugin below).
+# libspng decodes PNG files, OpenCV's imgcodecs the other formats (src/io/image_decoding.cpp).
 target_link_libraries(oefmt_io PUBLIC oefmt_estimation opencv_calib3d
-                               PRIVATE PkgConfig::LIBDEFLATE ${CMAKE_DL_LIBS})
+                               PRIVATE opencv_imgcodecs PkgConfig::SPNG)
 
 oefmt_layer_library(oefmt_evaluation evaluation)
 target_link_libraries(oefmt_evaluation PUBLIC oefmt_io Eigen3::Eigen)
 
 oefmt_layer_library(oefmt_sim sim)
 target_link_libraries(oefmt_sim PUBLIC oefmt_io)
-
-# liboefmt_image_codecs: OpenCV's imgcodecs as a plugin, loaded by oefmt_io the first time an
-# image needs it (src/io/image_codec_module.h says why); built beside the libraries.
-add_library(oefmt_image_codecs MODULE ${OEFMT_ROOT}/src/codecs/image_codec_module.cpp)
-target_include_directories(oefmt_image_codecs PRIVATE ${OEFMT_ROOT}/src/io)
-target_include_directories(oefmt_image_codecs SYSTEM PRIVATE ${OpenCV_INCLUDE_DIRS})
-target_link_libraries(oefmt_image_codecs PRIVATE opencv_core opencv_imgcodecs)
-add_dependencies(oefmt_io oefmt_image_codecs)

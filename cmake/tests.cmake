@@ -16,7 +16,6 @@ if(TARGET oefmt_tool_tests)
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"
     OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>"
     OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>"
-    OEFMT_IO_LIBRARY="$<TARGET_FILE:oefmt_io>"
     OEFMT_MEASURE_SPEED="${PROJECT_SOURCE_DIR}/scripts/measure_speed.py")
   add_dependencies(oefmt_tool_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline
                    oefmt_bag_source)

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Arbitrary bytes as a camera image -> prepareImage and Registrar::analyse. Inputs that start
-// like a PNG or JPEG file go through oefmt::decodeImage first (the dataset and compressed-image
-// path), and where its fast PNG decoder answers, the answer must equal cv::imdecode's; anything
-// else is read as a raw image: a header byte picks the pixel type, two more the size, and the
-// rest are the pixels (float types take the bytes as bit patterns: NaN, inf, denormals).
+// like a PNG or JPEG file go through oefmt::decodeImage first (the dataset folders' path: libspng
+// for PNGs), and where cv::imdecode (libpng for PNGs) also decodes them, the pictures must be
+// identical; anything else is read as a raw image: a header byte picks the pixel type, two more
+// the size, and the rest are the pixels (float types take the bytes as bit patterns: NaN, inf,
+// denormals).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <optional>
 #include <vector>
 
 #include <fuzzer/FuzzedDataProvider.h>
@@ -95,31 +95,26 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (looksCompressed(data, size)) {
-    // The fast PNG path, where it answers, must give cv::imdecode's picture; decodeImage is
-    // what datasets and compressed messages use (it calls the fast path first).
-    const std::optional<cv::Mat> fast = oefmt::decodePngFast(data, size);
-    if (fast) {
-      const cv::Mat bytes(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
-      cv::Mat reference;
-      try {
-        reference = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-      } catch (const cv::Exception&) {
-      }
-      // Where both decode the bytes, the pictures must be identical.
-      if (!reference.empty()) {
-        oefmt_fuzz::check(reference.type() == fast->type() && reference.size() == fast->size(),
-                          "fast PNG decoder: type or size differs from cv::imdecode");
-        oefmt_fuzz::check(cv::norm(reference, *fast, cv::NORM_INF) == 0.0,
-                          "fast PNG decoder: pixels differ from cv::imdecode");
-      }
-    }
     cv::Mat decoded;
     try {
-      decoded = fast ? *fast : oefmt::decodeImage(data, size);
+      decoded = oefmt::decodeImage(data, size);
     } catch (const oefmt::InputError&) {
-      return 0;  // documented: a header over the pixel limit
+      return 0;  // documented: not a readable image (corrupt, truncated, over the pixel limit)
     }
-    if (!decoded.empty()) analyse(decoded);
+    const cv::Mat bytes(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
+    cv::Mat reference;
+    try {
+      reference = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+    }
+    // Where both decode the bytes, the pictures must be identical.
+    if (!reference.empty()) {
+      oefmt_fuzz::check(reference.type() == decoded.type() && reference.size() == decoded.size(),
+                        "decodeImage: type or size differs from cv::imdecode");
+      oefmt_fuzz::check(cv::norm(reference, decoded, cv::NORM_INF) == 0.0,
+                        "decodeImage: pixels differ from cv::imdecode");
+    }
+    analyse(decoded);
     return 0;
   }
   FuzzedDataProvider input(data, size);

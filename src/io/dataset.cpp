@@ -19,20 +19,15 @@ namespace oefmt {
 namespace fs = std::filesystem;
 namespace {
 
-// readImageFile, or a DatasetError naming the file: missing, unreadable or corrupt, over the
-// size limit, or of a format the fast path does not read without the imgcodecs plugin.
+// readImageFile, or a DatasetError naming the file: missing, unreadable, corrupt or truncated,
+// over the size limit, or of no format the decoders know.
 cv::Mat readDatasetImage(const std::string& path) {
-  cv::Mat image;
   try {
-    image = readImageFile(path);
-  } catch (const std::exception& e) {
-    throw DatasetError("cannot read image '" + path + "': " + e.what());
+    return readImageFile(path);
+  } catch (const InputError& e) {
+    if (!fs::exists(path)) throw DatasetError("image '" + path + "' does not exist");
+    throw DatasetError(e.what());  // names the file
   }
-  if (image.empty()) {
-    throw DatasetError(fs::exists(path) ? "cannot read image '" + path + "' (not an image or corrupt)"
-                                        : "image '" + path + "' does not exist");
-  }
-  return image;
 }
 
 std::string trim(const std::string& text) {

@@ -5,19 +5,22 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "image_codec_module.h"
+#include <opencv2/imgcodecs.hpp>
+
 #include "oefmt/error.h"
 
 namespace oefmt {
 
 std::vector<std::uint8_t> encodeImage(const std::string& extension, const cv::Mat& image) {
   std::vector<std::uint8_t> bytes;
-  std::string error;
-  if (!detail::imageCodecModule().encode(extension, image, bytes, error)) {
-    throw InputError("cannot encode an image of type " + cv::typeToString(image.type()) + " as '" +
-                     extension + "': " + error);
+  std::string error = "OpenCV cannot encode it";
+  try {
+    if (cv::imencode("." + extension, image, bytes)) return bytes;
+  } catch (const cv::Exception& e) {
+    error = e.err;
   }
-  return bytes;
+  throw InputError("cannot encode an image of type " + cv::typeToString(image.type()) + " as '" + extension +
+                   "': " + error);
 }
 
 void writeImageFile(const std::string& path, const cv::Mat& image) {

@@ -35,8 +35,12 @@ long long floorIndex(double value) { return static_cast<long long>(std::floor(va
 long long floorDivide(long long a, long long b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 cv::Mat1f textureFromFile(const std::string& path) {
-  const cv::Mat image = readImageFile(path);
-  if (image.empty()) throw DatasetError("cannot read texture image '" + path + "'");
+  cv::Mat image;
+  try {
+    image = readImageFile(path);
+  } catch (const InputError& e) {
+    throw DatasetError(std::string("texture: ") + e.what());  // names the file
+  }
   cv::Mat1f grey = toGreyFloat(image);
   const int margin = std::max(4, std::min(grey.cols, grey.rows) / 8);
   if (grey.cols <= 2 * margin + 8 || grey.rows <= 2 * margin + 8) {

@@ -199,11 +199,11 @@ BENCHMARK(BM_Reference_FftPair)->Unit(benchmark::kMicrosecond);
 
 // ---- Stages -------------------------------------------------------------------------------
 
-// A 512 x 512 RGB PNG through the fast path (libdeflate inflate, unfilter, channel swap), as
-// oefmt_offline reads folders; the texture compresses differently from camera images.
+// A 512 x 512 RGB PNG through libspng and the channel swap, as oefmt_offline reads folders;
+// the texture compresses differently from camera images.
 void BM_Stage_DecodePng(benchmark::State& state) {
   const std::vector<std::uint8_t>& png = inputs().older_png;
-  for (auto _ : state) benchmark::DoNotOptimize(oefmt::decodePngFast(png.data(), png.size()));
+  for (auto _ : state) benchmark::DoNotOptimize(oefmt::decodeImage(png.data(), png.size()));
 }
 BENCHMARK(BM_Stage_DecodePng)->Unit(benchmark::kMicrosecond);
 

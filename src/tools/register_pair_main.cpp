@@ -65,11 +65,11 @@ int main(int argc, char** argv) {
       std::printf("generated pair: rotation %.3f deg, zoom %.4f, shift (%.2f, %.2f) px\n",
                   truth.rotation * 180.0 / CV_PI, truth.zoom, truth.shift.x, truth.shift.y);
     } else {
-      older = oefmt::readImageFile(older_path);
-      newer = oefmt::readImageFile(newer_path);
-      if (older.empty() || newer.empty()) {
-        std::fprintf(stderr, "oefmt_register_pair: cannot read image '%s'\n",
-                     (older.empty() ? older_path : newer_path).c_str());
+      try {
+        older = oefmt::readImageFile(older_path);
+        newer = oefmt::readImageFile(newer_path);
+      } catch (const oefmt::InputError& e) {  // names the file
+        std::fprintf(stderr, "oefmt_register_pair: %s\n", e.what());
         return 1;
       }
     }

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Image file encoding (simulated flights, bags of compressed images) through OpenCV's imgcodecs,
-// which the core loads on first use rather than linking it (see image_decoding.h).
+// Image file encoding (simulated flights, bags of compressed images) through OpenCV's imgcodecs.
 #pragma once
 
 #include <cstdint>
@@ -12,8 +11,7 @@
 namespace oefmt {
 
 /// `image` encoded as `extension` ("png", "jpg", ...: what cv::imencode takes, without the dot).
-/// Throws InputError when OpenCV cannot encode this image so, std::runtime_error when the
-/// imgcodecs plugin cannot be loaded.
+/// Throws InputError when OpenCV cannot encode this image so.
 std::vector<std::uint8_t> encodeImage(const std::string& extension, const cv::Mat& image);
 
 /// Writes encodeImage(the extension of `path`, image) to `path`. Throws as encodeImage, and
