@@ -3,6 +3,7 @@
 
 #include <spng.h>
 
+#include <algorithm>
 #include <climits>
 #include <cstring>
 #include <filesystem>
@@ -84,20 +85,40 @@ cv::Mat decodePng(const std::uint8_t* data, std::size_t size) {
   const Layout layout = layoutFor(header, transparency);
 
   cv::Mat image(static_cast<int>(header.height), static_cast<int>(header.width), layout.type);
+  const std::size_t row_bytes = image.cols * image.elemSize();
   std::size_t bytes = 0;
   check(spng_decoded_image_size(png, layout.format, &bytes), "image size");
-  if (bytes != image.total() * image.elemSize()) {
+  if (bytes != row_bytes * image.rows) {
     throw InputError("unsupported PNG (bit depth " + std::to_string(header.bit_depth) + ", colour type " +
                      std::to_string(header.color_type) + ")");
   }
-  check(spng_decode_image(png, image.data, bytes, layout.format, layout.flags), "image data");
+  check(spng_decode_image(png, nullptr, 0, layout.format, layout.flags | SPNG_DECODE_PROGRESSIVE), "image data");
+  // Row by row. Colour rows go through a block of kBlockRows rows that stays in cache, from which
+  // OpenCV's vectorised swap writes them in BGR(A) order: a whole decoded RGB image swapped
+  // afterwards is one more pass over memory. Grey rows, and the rows of an interlaced image
+  // (which every pass revisits), are decoded in place.
+  constexpr int kBlockRows = 16;
+  const bool swap = image.channels() > 1;
+  const bool in_place = !swap || header.interlace_method != SPNG_INTERLACE_NONE;
+  cv::Mat block;
+  if (!in_place) block.create(std::min(kBlockRows, image.rows), image.cols, image.type());
+  const int swap_code = image.channels() == 3 ? cv::COLOR_RGB2BGR : cv::COLOR_RGBA2BGRA;
+  int status = SPNG_OK;
+  while (status == SPNG_OK) {
+    spng_row_info row{};
+    check(spng_get_row_info(png, &row), "image data");
+    const int y = static_cast<int>(row.row_num);
+    status = spng_decode_row(png, in_place ? image.ptr(y) : block.ptr(y % kBlockRows), row_bytes);
+    if (!in_place && (status == SPNG_OK || status == SPNG_EOI) &&
+        (y % kBlockRows == kBlockRows - 1 || y == image.rows - 1)) {
+      const int first = y - y % kBlockRows;
+      cv::cvtColor(block.rowRange(0, y - first + 1), image.rowRange(first, y + 1), swap_code);
+    }
+  }
+  if (status != SPNG_EOI) check(status, "image data");
   // The chunks after the image, up to IEND: a file cut short after its image data is refused too.
   check(spng_decode_chunks(png), "end of file");
-  if (image.channels() == 3) {
-    cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
-  } else if (image.channels() == 4) {
-    cv::cvtColor(image, image, cv::COLOR_RGBA2BGRA);
-  }
+  if (swap && in_place) cv::cvtColor(image.clone(), image, swap_code);
   return image;
 }
 
