@@ -6,17 +6,15 @@ catkin_add_gtest(oefmt_tool_tests test/tools/test_bag_io.cpp test/tools/test_too
                  test/tools/test_debug_rendering.cpp test/tools/test_frame_source.cpp
                  test/tools/test_stamp_guard.cpp test/tools/test_frame_queue.cpp
                  test/tools/test_rectification.cpp
-                 src/tools/frame_source.cpp test/support/gtest_main.cpp)
+                 src/tools/frame_source.cpp src/tools/bag_source.cpp test/support/gtest_main.cpp)
 if(TARGET oefmt_tool_tests)
   target_include_directories(oefmt_tool_tests PRIVATE test src/tools)
-  target_link_libraries(oefmt_tool_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_evaluation opencv_imgcodecs
-                        ${CMAKE_DL_LIBS})
+  target_link_libraries(oefmt_tool_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_evaluation opencv_imgcodecs)
   target_compile_definitions(oefmt_tool_tests PRIVATE
     OEFMT_SIMULATE="$<TARGET_FILE:oefmt_simulate>"
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"
     OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>"
     OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>"
     OEFMT_MEASURE_SPEED="${PROJECT_SOURCE_DIR}/scripts/measure_speed.py")
-  add_dependencies(oefmt_tool_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline
-                   oefmt_bag_source)
+  add_dependencies(oefmt_tool_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline)
 endif()

@@ -10,12 +10,6 @@ install(TARGETS oefmt_bag_io
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   RUNTIME DESTINATION ${CATKIN_GLOBAL_BIN_DESTINATION})
 
-# liboefmt_bag_source: oefmt_offline's bag reader, a plugin it loads for --bag only, so that a
-# folder's run does not load the ROS libraries and cv_bridge (src/tools/frame_source.h).
-add_library(oefmt_bag_source MODULE src/tools/bag_source.cpp)
-target_link_libraries(oefmt_bag_source PRIVATE oefmt_bag_io)
-install(TARGETS oefmt_bag_source LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
-
 oefmt_add_tool(oefmt_simulate src/tools/simulate_main.cpp)
 target_link_libraries(oefmt_simulate oefmt_bag_io)
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// liboefmt_bag_source.so: oefmt_offline's frames from a bag, a plugin loaded for --bag only
-// (see openBag in frame_source.h).
+// oefmt_offline's frames from a bag (see openBag in frame_source.h).
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -58,9 +58,10 @@ class BagSource : public FrameSource {
 };
 
 }  // namespace
-}  // namespace oefmt
 
-extern "C" oefmt::FrameSource* oefmt_open_bag_source_v1(const std::string& path, const std::string& image_topic,
-                                                        const std::string& camera_info_topic) {
-  return new oefmt::BagSource(path, image_topic, camera_info_topic);
+std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string& image_topic,
+                                     const std::string& camera_info_topic) {
+  return std::make_unique<BagSource>(path, image_topic, camera_info_topic);
 }
+
+}  // namespace oefmt

@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "frame_source.h"
 
-#include <dlfcn.h>
-
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -48,54 +46,10 @@ class FolderSource : public FrameSource {
   std::size_t index_ = 0;
 };
 
-// oefmt_offline reads bags through a plugin, loaded for the first bag: linked, the ROS libraries
-// and cv_bridge (which brings OpenCV's imgcodecs and its ~150 libraries) would cost every run,
-// folders included, ~0.2 s of start-up and ~40 MB.
-constexpr const char* kBagSourceModuleFile = "liboefmt_bag_source.so";
-using OpenBagSource = FrameSource* (*)(const std::string& path, const std::string& image_topic,
-                                       const std::string& camera_info_topic);
-
-OpenBagSource loadBagSourceModule() {
-  static const std::pair<OpenBagSource, std::string> loaded = [] {
-    std::vector<std::string> candidates;
-    // Built and installed beside liboefmt_io.so (the executables are a folder below).
-    Dl_info info{};
-    if (::dladdr(reinterpret_cast<const void*>(&decodeImage), &info) != 0 && info.dli_fname != nullptr) {
-      candidates.push_back((std::filesystem::path(info.dli_fname).parent_path() / kBagSourceModuleFile).string());
-    }
-    candidates.emplace_back(kBagSourceModuleFile);  // LD_LIBRARY_PATH, the loader's cache
-    std::string errors;
-    for (const std::string& candidate : candidates) {
-      void* handle = ::dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
-      if (handle == nullptr) {
-        const char* reason = ::dlerror();
-        errors += "\n  " + (reason ? std::string(reason) : candidate + ": not loadable");
-        continue;
-      }
-      // The symbol names the interface's version: a stale plugin is not found, so not called.
-      if (void* entry = ::dlsym(handle, kBagSourceModuleSymbol)) {
-        return std::make_pair(reinterpret_cast<OpenBagSource>(entry), std::string());  // kept loaded
-      }
-      errors += "\n  " + candidate + ": not this version's plugin (rebuild oefmt)";
-      ::dlclose(handle);
-    }
-    return std::make_pair(OpenBagSource{nullptr}, std::string("cannot load the bag reader plugin ") +
-                                                     kBagSourceModuleFile + " (built and installed with oefmt):" +
-                                                     errors);
-  }();
-  if (loaded.first == nullptr) throw std::runtime_error(loaded.second);
-  return loaded.first;
-}
-
 }  // namespace
 
 std::unique_ptr<FrameSource> openFolder(const std::string& directory) {
   return std::make_unique<FolderSource>(directory);
-}
-
-std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string& image_topic,
-                                     const std::string& camera_info_topic) {
-  return std::unique_ptr<FrameSource>(loadBagSourceModule()(path, image_topic, camera_info_topic));
 }
 
 PrefetchingSource::PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth,

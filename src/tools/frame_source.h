@@ -51,13 +51,10 @@ class FrameSource {
 };
 
 std::unique_ptr<FrameSource> openFolder(const std::string& directory);
-/// A bag's frames (oefmt/ros/bag_io.h's BagImageReader), read by liboefmt_bag_source.so: a
-/// plugin loaded for the first bag, so that the ROS libraries are no part of a folder's run.
-/// Throws BagError for the bag, std::runtime_error when the plugin cannot be loaded.
+/// A bag's frames (oefmt/ros/bag_io.h's BagImageReader; src/tools/bag_source.cpp). Throws
+/// BagError for the bag.
 std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string& image_topic,
                                      const std::string& camera_info_topic);
-/// The plugin's entry (extern "C"; its name carries the interface's version): a new BagSource.
-constexpr const char* kBagSourceModuleSymbol = "oefmt_open_bag_source_v1";
 
 /// Reads ahead from a source on its own thread, at most `depth` frames. With `analyse`, each
 /// frame's spectra are made on that thread too (and the decoded image released).
