@@ -73,17 +73,6 @@ struct WindowFrame {
 
 }  // namespace
 
-const char* toString(TrackingState state) {
-  switch (state) {
-    case TrackingState::kStarted: return "started";
-    case TrackingState::kTracking: return "tracking";
-    case TrackingState::kPredicted: return "predicted";
-    case TrackingState::kHeld: return "held";
-    case TrackingState::kRestarted: return "restarted";
-  }
-  return "unknown";
-}
-
 // The window, the previous pair and the per-size machinery; one method per stage of a frame.
 struct Estimator::State {
   State(const EstimatorConfig& c, std::shared_ptr<const SpectralContext> context)

@@ -61,6 +61,14 @@ std::string readString(const YamlNode& node, const std::string& key) {
   return trimmed(scalarOf(node, key, "a word"));
 }
 
+// One of an enum's words (its name table), the message listing them.
+template <typename T, std::size_t N>
+T readWord(const YamlNode& node, const std::string& key, const EnumName<T> (&names)[N]) {
+  const std::optional<T> value = findEnum(names, readString(node, key));
+  if (!value) badValue(key, wordList(enumNames(names)));
+  return *value;
+}
+
 // ---- writing one value -------------------------------------------------------------------
 
 // A double that both OpenCV and PyYAML read back as a number (YAML 1.1 wants a dot).
@@ -101,18 +109,16 @@ Field boolean(const std::string& key, bool& target) {
           [&target] { return std::string(target ? "true" : "false"); }};
 }
 
+template <typename T, std::size_t N>
+Field word(const std::string& key, T& target, const EnumName<T> (&names)[N]) {
+  return {key, [&target, &names](const YamlNode& n, const std::string& k) { target = readWord(n, k, names); },
+          [&target, &names] { return std::string(enumName(names, target)); }};
+}
+
 std::vector<Section> sections(EstimatorConfig& c) {
   std::vector<Section> all;
   all.push_back({"",
-                 {{"mode",
-                   [&c](const YamlNode& n, const std::string& k) {
-                     try {
-                       c.mode = parseEstimatorMode(readString(n, k));
-                     } catch (const InputError&) {
-                       badValue(k, "oefmt, efmt or fmt");
-                     }
-                   },
-                   [&c] { return std::string(toString(c.mode)); }},
+                 {word("mode", c.mode, kEstimatorModeNames),
                   number("altitude", c.altitude), number("fx", c.fx),
                   boolean("parallel_registrations", c.parallel_registrations)},
                  [&c] {
@@ -132,19 +138,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
                   integer("rotation_zoom_candidates", r.rotation_zoom_candidates),
                   number("identity_warp_px", r.identity_warp_px),
                   boolean("noise_weighting", r.noise_weighting),
-                  {"fft_planning",
-                   [&r](const YamlNode& n, const std::string& k) {
-                     const std::string v = readString(n, k);
-                     for (const FftPlanning planning :
-                          {FftPlanning::kEstimate, FftPlanning::kMeasure, FftPlanning::kPatient}) {
-                       if (v == toString(planning)) {
-                         r.fft_planning = planning;
-                         return;
-                       }
-                     }
-                     badValue(k, "estimate, measure or patient");
-                   },
-                   [&r] { return std::string(toString(r.fft_planning)); }}},
+                  word("fft_planning", r.fft_planning, kFftPlanningNames)},
                  [&r] { r.validate(); }});
   MatchingConfig& m = c.matching;
   all.push_back({"matching",
@@ -162,20 +156,7 @@ std::vector<Section> sections(EstimatorConfig& c) {
   LocalOptimizerOptions& o = c.optimizer;
   all.push_back({"optimizer",
                  {integer("max_iterations", o.max_iterations),
-                  {"robust_loss",
-                   [&o](const YamlNode& n, const std::string& k) {
-                     const std::string v = readString(n, k);
-                     if (v == "cauchy") {
-                       o.robust_loss = RobustLoss::kCauchy;
-                     } else if (v == "huber") {
-                       o.robust_loss = RobustLoss::kHuber;
-                     } else if (v == "none") {
-                       o.robust_loss = RobustLoss::kNone;
-                     } else {
-                       badValue(k, "cauchy, huber or none");
-                     }
-                   },
-                   [&o] { return std::string(toString(o.robust_loss)); }},
+                  word("robust_loss", o.robust_loss, kRobustLossNames),
                   number("loss_scale", o.loss_scale),
                   number("loop_translation_sigma", o.loop_translation_sigma),
                   number("loop_translation_sigma_relative", o.loop_translation_sigma_relative),
@@ -234,22 +215,6 @@ void validateSection(const Section& section) {
 }
 
 }  // namespace
-
-const char* toString(EstimatorMode mode) {
-  switch (mode) {
-    case EstimatorMode::kOefmt: return "oefmt";
-    case EstimatorMode::kEfmt: return "efmt";
-    case EstimatorMode::kFmt: return "fmt";
-  }
-  return "unknown";
-}
-
-EstimatorMode parseEstimatorMode(const std::string& text) {
-  if (text == "oefmt") return EstimatorMode::kOefmt;
-  if (text == "efmt") return EstimatorMode::kEfmt;
-  if (text == "fmt") return EstimatorMode::kFmt;
-  throw InputError("unknown mode '" + text + "': expected oefmt, efmt or fmt");
-}
 
 void MatchingConfig::validate() const {
   requireParameter(stretch_steps >= 2 && stretch_steps <= 1000, "stretch_steps", "must be in [2, 1000]");

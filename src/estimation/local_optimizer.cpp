@@ -289,24 +289,6 @@ LoopResiduals loopResiduals(const PairMotion& p01, const PairMotion& p12, const 
   return r;
 }
 
-const char* toString(RobustLoss loss) {
-  switch (loss) {
-    case RobustLoss::kNone: return "none";
-    case RobustLoss::kHuber: return "huber";
-    case RobustLoss::kCauchy: return "cauchy";
-  }
-  return "unknown";
-}
-
-const char* toString(OptimizerStatus status) {
-  switch (status) {
-    case OptimizerStatus::kConverged: return "converged";
-    case OptimizerStatus::kFallback: return "fallback";
-    case OptimizerStatus::kSkipped: return "skipped";
-  }
-  return "unknown";
-}
-
 void LocalOptimizerOptions::validate() const {
   requireParameter(max_iterations >= 1 && max_iterations <= 1000, "max_iterations", "must be in [1, 1000]");
   requireParameter(std::isfinite(loss_scale) && loss_scale > 0.0, "loss_scale", "must be > 0");

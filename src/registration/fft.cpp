@@ -70,15 +70,6 @@ bool exportWisdomLocked(const std::string& path) {
 
 }  // namespace
 
-const char* toString(FftPlanning planning) {
-  switch (planning) {
-    case FftPlanning::kEstimate: return "estimate";
-    case FftPlanning::kMeasure: return "measure";
-    case FftPlanning::kPatient: return "patient";
-  }
-  return "unknown";
-}
-
 void setFftWisdomFile(const std::string& path) {
   std::lock_guard<std::mutex> lock(plannerMutex());
   wisdomFile() = path;

@@ -89,15 +89,6 @@ double confidenceFrom(double psr, double floor, double good) {
 
 }  // namespace
 
-const char* toString(RegistrationStatus status) {
-  switch (status) {
-    case RegistrationStatus::kOk: return "ok";
-    case RegistrationStatus::kLowConfidence: return "low_confidence";
-    case RegistrationStatus::kTextureless: return "textureless";
-  }
-  return "unknown";
-}
-
 Registrar::Registrar(const RegistrationConfig& config)
     : Registrar(std::make_shared<const SpectralContext>(config)) {}
 

@@ -18,15 +18,4 @@ StampGuard::Verdict StampGuard::check(double stamp) {
   return Verdict::kJumpBack;
 }
 
-const char* toString(StampGuard::Verdict verdict) {
-  switch (verdict) {
-    case StampGuard::Verdict::kAccept: return "accepted";
-    case StampGuard::Verdict::kDuplicate: return "duplicate stamp";
-    case StampGuard::Verdict::kOutOfOrder: return "stamp older than the previous frame";
-    case StampGuard::Verdict::kJumpBack: return "time jumped back";
-    case StampGuard::Verdict::kInvalid: return "stamp is not finite";
-  }
-  return "unknown";
-}
-
 }  // namespace oefmt

@@ -157,28 +157,6 @@ int wholePeriods(int size, int period) {
 
 }  // namespace
 
-TextureStyle textureStyleFromString(const std::string& name) {
-  for (TextureStyle style : {TextureStyle::kMixed, TextureStyle::kCells, TextureStyle::kStripes, TextureStyle::kNoise,
-                             TextureStyle::kNatural, TextureStyle::kBrick, TextureStyle::kTiles}) {
-    if (name == toString(style)) return style;
-  }
-  throw InputError("unknown texture style '" + name +
-                   "' (expected mixed, cells, stripes, noise, natural, brick or tiles)");
-}
-
-const char* toString(TextureStyle style) {
-  switch (style) {
-    case TextureStyle::kNoise: return "noise";
-    case TextureStyle::kCells: return "cells";
-    case TextureStyle::kStripes: return "stripes";
-    case TextureStyle::kNatural: return "natural";
-    case TextureStyle::kBrick: return "brick";
-    case TextureStyle::kTiles: return "tiles";
-    case TextureStyle::kMixed: return "mixed";
-  }
-  return "?";
-}
-
 TextureStyle layerTextureStyle(const std::vector<TextureStyle>& styles, int layer) {
   const TextureStyle style = styles.empty() ? TextureStyle::kMixed
                                             : styles[std::min(static_cast<std::size_t>(layer), styles.size() - 1)];

@@ -139,23 +139,5 @@ std::vector<FlightPose> makeTrack(const TrackConfig& config) {
   return poses;
 }
 
-TrackShape trackShapeFromString(const std::string& name) {
-  if (name == "circle") return TrackShape::kCircle;
-  if (name == "eight") return TrackShape::kEight;
-  if (name == "line") return TrackShape::kLine;
-  if (name == "spin") return TrackShape::kSpin;
-  throw InputError("unknown track '" + name + "' (expected circle, eight, line or spin)");
-}
-
-const char* toString(TrackShape shape) {
-  switch (shape) {
-    case TrackShape::kCircle: return "circle";
-    case TrackShape::kEight: return "eight";
-    case TrackShape::kLine: return "line";
-    case TrackShape::kSpin: return "spin";
-  }
-  return "?";
-}
-
 }  // namespace sim
 }  // namespace oefmt

@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/error.h"
 
 namespace oefmt {
@@ -102,6 +103,23 @@ CLI::Option* addChoice(CLI::App& app, const std::string& name, T& value,
           help)
       ->type_name(shown)
       ->check(member);
+}
+
+/// The same for an enum with a name table: its words are the table's.
+template <typename T, std::size_t N>
+CLI::Option* addChoice(CLI::App& app, const std::string& name, T& value, const EnumName<T> (&names)[N],
+                       const std::string& help) {
+  std::vector<std::pair<std::string, T>> words;
+  for (const EnumName<T>& entry : names) words.emplace_back(entry.name, entry.value);
+  return addChoice(app, name, value, words, help);
+}
+
+/// "a|b|c": an enum's words as the help shows them.
+template <typename T, std::size_t N>
+std::string shownWords(const EnumName<T> (&names)[N]) {
+  std::string shown;
+  for (const EnumName<T>& entry : names) shown += (shown.empty() ? "" : "|") + std::string(entry.name);
+  return shown;
 }
 
 /// A text option that is one of `words`.

@@ -79,8 +79,7 @@ TUM files: 't x y z qx qy qz qw' per line, '#' comments.)",
       app, "exit codes: 0 success, 1 unreadable input or too few matches, 2 invalid option, 3 plot failed");
   app.add_option("ESTIMATE.tum", c.estimate, "estimated trajectory")->type_name("")->required();
   app.add_option("GROUNDTRUTH.tum", c.truth, "ground truth")->type_name("")->required();
-  oefmt::tools::addChoice(app, "--match", c.options.association,
-                          {{"time", oefmt::AssociationMode::kTimestamp}, {"index", oefmt::AssociationMode::kIndex}},
+  oefmt::tools::addChoice(app, "--match", c.options.association, oefmt::kAssociationModeNames,
                           "associate by timestamp (default) or by line index");
   const CLI::Option* tolerance = oefmt::tools::addNumber(app, "--tolerance", c.options.time_tolerance, "S",
                                                          "largest time difference of a match [s] (default 0.02)");

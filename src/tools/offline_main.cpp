@@ -68,9 +68,10 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
       ->type_name("FILE");
   app.add_option("--config", o.config, "parameters (config/default.yaml documents every key)")->type_name("FILE");
   app.add_option_function<std::string>(
-         "--mode", [&o](const std::string& mode) { o.mode = oefmt::parseEstimatorMode(mode); },
+         "--mode",
+         [&o](const std::string& mode) { o.mode = oefmt::parseEnum(oefmt::kEstimatorModeNames, mode, "mode"); },
          "overrides the config's mode")
-      ->type_name("oefmt|efmt|fmt");
+      ->type_name(oefmt::tools::shownWords(oefmt::kEstimatorModeNames));
   oefmt::tools::addNumber(app, "--altitude", o.altitude, "M",
                           "altitude above the dominant plane at the first frame [m]: metric\n"
                           "output (otherwise units of the initial altitude)");

@@ -53,7 +53,7 @@ std::vector<oefmt::sim::TextureStyle> textureStyles(const std::string& text) {
   std::string name;
   while (std::getline(list, name, ',')) {
     try {
-      styles.push_back(oefmt::sim::textureStyleFromString(name));
+      styles.push_back(oefmt::parseEnum(oefmt::sim::kTextureStyleNames, name, "texture style"));
     } catch (const oefmt::InputError& e) {
       throw oefmt::InputError(std::string("--texture-style: ") + e.what());
     }
@@ -110,9 +110,12 @@ Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames,
 
   const std::string track = "track";
   app.add_option_function<std::string>(
-         "--track", [&f](const std::string& name) { f.track.shape = oefmt::sim::trackShapeFromString(name); },
+         "--track",
+         [&f](const std::string& name) {
+           f.track.shape = oefmt::parseEnum(oefmt::sim::kTrackShapeNames, name, "track");
+         },
          "shape (default circle); spin: no motion, the camera turns on the\nspot at the origin")
-      ->type_name("circle|eight|line|spin")
+      ->type_name(oefmt::tools::shownWords(oefmt::sim::kTrackShapeNames))
       ->group(track);
   const CLI::Option* length =
       addNumber(app, "--length", f.track.length, "M",
@@ -133,16 +136,14 @@ Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames,
   addNumber(app, "--climb", f.track.climb, "M", "altitude change [m], negative for a descent (default 0; not spin)")
       ->group(track);
   const CLI::Option* profile =
-      addChoice(app, "--climb-profile", f.track.climb_profile,
-                {{"ramp", oefmt::sim::ClimbProfile::kRamp}, {"hill", oefmt::sim::ClimbProfile::kHill}},
+      addChoice(app, "--climb-profile", f.track.climb_profile, oefmt::sim::kClimbProfileNames,
                 "how a line changes altitude: ramp = linearly to altitude + climb\n"
                 "(default), hill = smoothly to it half-way and back; loops: hill")
           ->group(track);
   const CLI::Option* spin_rate =
       addAngle("--spin-rate", f.track.spin_rate, "yaw change per frame of a spin, either sign (default 6)")
           ->group(track);
-  addChoice(app, "--heading", f.track.heading,
-            {{"fixed", oefmt::sim::HeadingMode::kFixed}, {"track", oefmt::sim::HeadingMode::kTrack}},
+  addChoice(app, "--heading", f.track.heading, oefmt::sim::kHeadingModeNames,
             "yaw fixed, or following the direction of motion (default fixed)")
       ->group(track);
   addAngle("--yaw", f.track.yaw, "fixed yaw, or offset to the direction of motion (default 0)")->group(track);

@@ -130,6 +130,7 @@ TEST(Tools, SimulateCorpusOptions) {
       {"--track spin --spin-rate 200", "--spin-rate must be in (-180, 180) deg"},
       {"--climb-profile ramp", "--climb-profile ramp needs --track line"},
       {"--climb-profile up", "--climb-profile: up not in {ramp,hill}"},
+      {"--heading north", "--heading: north not in {fixed,track}"},
       {"--texture-style cells,marble", "--texture-style: unknown texture style 'marble'"},
       {"--contrast 0", "--contrast must be in (0, 127.5]"},
       {"--flicker 1", "--flicker must be in [0, 1)"},
@@ -146,7 +147,7 @@ TEST(Tools, ExitCodesAndMessages) {
 
   ToolRun bad = run(dir, std::string(OEFMT_SIMULATE) + " --track square " + (dir / "x"));
   EXPECT_EQ(bad.status, 2);
-  EXPECT_NE(bad.err.find("unknown track 'square'"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("unknown track 'square': expected circle, eight, line or spin"), std::string::npos) << bad.err;
   bad = run(dir, std::string(OEFMT_SIMULATE) + " --frames");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("--frames: 1 required N missing"), std::string::npos) << bad.err;

@@ -149,9 +149,9 @@ TEST(EstimatorConfig, ScaleHelpers) {
   c.altitude = 50.0;
   EXPECT_DOUBLE_EQ(c.effectiveFx(), 400.0);
   EXPECT_DOUBLE_EQ(c.initialAltitude(), 50.0);
-  EXPECT_EQ(parseEstimatorMode("efmt"), EstimatorMode::kEfmt);
+  EXPECT_EQ(parseEnum(kEstimatorModeNames, "efmt", "mode"), EstimatorMode::kEfmt);
   EXPECT_STREQ(toString(EstimatorMode::kOefmt), "oefmt");
-  EXPECT_THROW(parseEstimatorMode("OEFMT"), InputError);
+  EXPECT_THROW(parseEnum(kEstimatorModeNames, "OEFMT", "mode"), InputError);
 }
 
 }  // namespace

@@ -52,10 +52,10 @@ double seamRatio(const cv::Mat1f& t) {
 }
 
 TEST(SimTexture, StylesByNameAndPerLayer) {
-  EXPECT_EQ(textureStyleFromString("brick"), TextureStyle::kBrick);
-  EXPECT_EQ(textureStyleFromString("natural"), TextureStyle::kNatural);
+  EXPECT_EQ(parseEnum(kTextureStyleNames, "brick", "style"), TextureStyle::kBrick);
+  EXPECT_EQ(parseEnum(kTextureStyleNames, "natural", "style"), TextureStyle::kNatural);
   EXPECT_STREQ(toString(TextureStyle::kTiles), "tiles");
-  EXPECT_THROW(textureStyleFromString("marble"), InputError);
+  EXPECT_THROW(parseEnum(kTextureStyleNames, "marble", "style"), InputError);
   // Mixed: today's choice by layer; a list's last style serves the layers beyond it.
   EXPECT_EQ(layerTextureStyle({}, 0), TextureStyle::kCells);
   EXPECT_EQ(layerTextureStyle({}, 1), TextureStyle::kStripes);

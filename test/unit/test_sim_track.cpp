@@ -107,8 +107,9 @@ TEST(SimTrack, RejectsInvalidConfigurations) {
   config.length = 10.0;
   config.climb = -20.0;
   EXPECT_THROW(makeTrack(config), InputError);
-  EXPECT_THROW(trackShapeFromString("square"), InputError);
-  EXPECT_EQ(trackShapeFromString("eight"), TrackShape::kEight);
+  EXPECT_THROW(parseEnum(kTrackShapeNames, "square", "track"), InputError);
+  EXPECT_EQ(parseEnum(kTrackShapeNames, "eight", "track"), TrackShape::kEight);
+  for (const auto& entry : kTrackShapeNames) EXPECT_EQ(parseEnum(kTrackShapeNames, toString(entry.value), "track"), entry.value);
 }
 
 CameraParameters squareCamera(int size, double fx) {

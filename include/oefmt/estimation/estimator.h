@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/estimation/estimator_config.h"
 #include "oefmt/estimation/local_optimizer.h"
 #include "oefmt/registration/pattern_matching.h"
@@ -29,7 +30,11 @@ enum class TrackingState {
   kHeld,       ///< the frame could not be registered and there was no motion to extrapolate
   kRestarted,  ///< too many frames failed: the window restarts from this frame, pose continues
 };
-const char* toString(TrackingState state);
+inline constexpr EnumName<TrackingState> kTrackingStateNames[] = {
+    {TrackingState::kStarted, "started"}, {TrackingState::kTracking, "tracking"},
+    {TrackingState::kPredicted, "predicted"}, {TrackingState::kHeld, "held"},
+    {TrackingState::kRestarted, "restarted"}};
+inline const char* toString(TrackingState state) { return enumName(kTrackingStateNames, state); }
 
 /// Everything the estimator knows after one frame: the pose, and for diagnostics the newest pair
 /// (previous accepted frame "1" -> this frame "2") and, in oefmt mode, pair 0-2 and the loop.

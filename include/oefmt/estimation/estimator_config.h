@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/registration/registration_config.h"
 #include "oefmt/estimation/local_optimizer.h"
 #include "oefmt/io/yaml_map.h"
@@ -17,9 +18,9 @@ enum class EstimatorMode {
   kEfmt,   ///< original eFMT: multi-zoom translation profiles, consecutive pairs, PMT scale chain
   kFmt,    ///< classic FMT: single peaks, consecutive pairs
 };
-const char* toString(EstimatorMode mode);
-/// "oefmt", "efmt" or "fmt"; throws InputError otherwise.
-EstimatorMode parseEstimatorMode(const std::string& text);
+inline constexpr EnumName<EstimatorMode> kEstimatorModeNames[] = {
+    {EstimatorMode::kOefmt, "oefmt"}, {EstimatorMode::kEfmt, "efmt"}, {EstimatorMode::kFmt, "fmt"}};
+inline const char* toString(EstimatorMode mode) { return enumName(kEstimatorModeNames, mode); }
 
 /// Pattern matching of energy vectors (doc/method.md, Pattern matching).
 struct MatchingConfig {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/estimation/pair_motion.h"
 
 namespace oefmt {
@@ -55,7 +56,9 @@ LoopResiduals loopResiduals(const PairMotion& pair01, const PairMotion& pair12,
                             const PairMotion& pair02);
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
-const char* toString(RobustLoss loss);
+inline constexpr EnumName<RobustLoss> kRobustLossNames[] = {
+    {RobustLoss::kNone, "none"}, {RobustLoss::kHuber, "huber"}, {RobustLoss::kCauchy, "cauchy"}};
+inline const char* toString(RobustLoss loss) { return enumName(kRobustLossNames, loss); }
 
 struct LocalOptimizerOptions {
   int max_iterations = 50;                 ///< Levenberg-Marquardt iterations
@@ -80,7 +83,10 @@ enum class OptimizerStatus {
   kFallback,   ///< the solve failed or was not finite: the pairs are the measurements
   kSkipped,    ///< not run (no usable 0-2 pair, fmt/efmt mode): the pairs are the measurements
 };
-const char* toString(OptimizerStatus status);
+inline constexpr EnumName<OptimizerStatus> kOptimizerStatusNames[] = {
+    {OptimizerStatus::kConverged, "converged"}, {OptimizerStatus::kFallback, "fallback"},
+    {OptimizerStatus::kSkipped, "skipped"}};
+inline const char* toString(OptimizerStatus status) { return enumName(kOptimizerStatusNames, status); }
 
 /// Result of one local optimization. pair12/pair02 carry posterior sigmas when converged.
 struct LoopSolution {

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/io/tum.h"
 
 namespace oefmt {
@@ -54,6 +55,9 @@ struct ErrorStatistics {
 ErrorStatistics errorStatistics(std::vector<double> errors);
 
 enum class AssociationMode { kTimestamp, kIndex };
+/// oefmt_evaluate's --match words.
+inline constexpr EnumName<AssociationMode> kAssociationModeNames[] = {
+    {AssociationMode::kTimestamp, "time"}, {AssociationMode::kIndex, "index"}};
 
 struct EvaluationOptions {
   AssociationMode association = AssociationMode::kTimestamp;

@@ -8,6 +8,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/enum_names.h"
+
 namespace oefmt {
 
 using Complex = std::complex<float>;
@@ -17,8 +19,10 @@ using Complex = std::complex<float>;
 /// times as long as kMeasure's to make and ran faster (doc/performance.md), which pays off
 /// from the first run on, as the wisdom keeps them.
 enum class FftPlanning { kEstimate, kMeasure, kPatient };
-/// "estimate", "measure" or "patient" (the configuration's spelling).
-const char* toString(FftPlanning planning);
+/// The configuration's spelling of each effort.
+inline constexpr EnumName<FftPlanning> kFftPlanningNames[] = {
+    {FftPlanning::kEstimate, "estimate"}, {FftPlanning::kMeasure, "measure"}, {FftPlanning::kPatient, "patient"}};
+inline const char* toString(FftPlanning planning) { return enumName(kFftPlanningNames, planning); }
 
 /// Forward (real -> half spectrum) and inverse (half spectrum -> real) transforms of
 /// size x size images. Plans are made once in the constructor; execution is thread-safe, so one

@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/registration/registration_config.h"
 #include "oefmt/registration/phase_correlation.h"
 #include "oefmt/registration/spectra.h"
@@ -24,7 +25,10 @@ enum class RegistrationStatus {
   kLowConfidence,  ///< computed, but the peaks are weak (little overlap, blur, noise)
   kTextureless,    ///< a frame is constant, black or saturated: nothing was estimated
 };
-const char* toString(RegistrationStatus status);
+inline constexpr EnumName<RegistrationStatus> kRegistrationStatusNames[] = {
+    {RegistrationStatus::kOk, "ok"}, {RegistrationStatus::kLowConfidence, "low_confidence"},
+    {RegistrationStatus::kTextureless, "textureless"}};
+inline const char* toString(RegistrationStatus status) { return enumName(kRegistrationStatusNames, status); }
 
 /// The registration of an older frame A to a newer frame B.
 /// Axes: x right, y down (image). Angles: atan2(dy, dx) in these axes.

@@ -3,6 +3,8 @@
 // are dropped, a large step back (a bag that loops, a restarted recording) asks for a reset.
 #pragma once
 
+#include "oefmt/enum_names.h"
+
 namespace oefmt {
 
 class StampGuard {
@@ -30,6 +32,13 @@ class StampGuard {
   double last_ = 0.0;
 };
 
-const char* toString(StampGuard::Verdict verdict);
+/// What each verdict means, for messages.
+inline constexpr EnumName<StampGuard::Verdict> kStampVerdictNames[] = {
+    {StampGuard::Verdict::kAccept, "accepted"},
+    {StampGuard::Verdict::kDuplicate, "duplicate stamp"},
+    {StampGuard::Verdict::kOutOfOrder, "stamp older than the previous frame"},
+    {StampGuard::Verdict::kJumpBack, "time jumped back"},
+    {StampGuard::Verdict::kInvalid, "stamp is not finite"}};
+inline const char* toString(StampGuard::Verdict verdict) { return enumName(kStampVerdictNames, verdict); }
 
 }  // namespace oefmt

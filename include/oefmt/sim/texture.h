@@ -8,6 +8,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/enum_names.h"
+
 namespace oefmt {
 namespace sim {
 
@@ -23,9 +25,12 @@ enum class TextureStyle {
   kMixed,
 };
 
-/// "noise", "cells", "stripes", "natural", "brick", "tiles", "mixed" -> style; InputError otherwise.
-TextureStyle textureStyleFromString(const std::string& name);
-const char* toString(TextureStyle style);
+/// The command line's spelling of each style (parseEnum reads it).
+inline constexpr EnumName<TextureStyle> kTextureStyleNames[] = {
+    {TextureStyle::kMixed, "mixed"},     {TextureStyle::kCells, "cells"}, {TextureStyle::kStripes, "stripes"},
+    {TextureStyle::kNoise, "noise"},     {TextureStyle::kNatural, "natural"},
+    {TextureStyle::kBrick, "brick"},     {TextureStyle::kTiles, "tiles"}};
+inline const char* toString(TextureStyle style) { return enumName(kTextureStyleNames, style); }
 
 /// The style of a scene's layer (0 ground, k level k): styles[layer], the last style beyond the
 /// list, kMixed for an empty list; kMixed resolved to the layer's mixed choice.

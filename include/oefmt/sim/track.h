@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "oefmt/enum_names.h"
 #include "oefmt/sim/camera_model.h"
 
 namespace oefmt {
@@ -65,9 +66,15 @@ double frameSpacing(const TrackConfig& config);
 /// The camera pose of every frame, at equal distances along the track.
 std::vector<FlightPose> makeTrack(const TrackConfig& config);
 
-/// "circle", "eight", "line", "spin" -> shape; throws InputError otherwise.
-TrackShape trackShapeFromString(const std::string& name);
-const char* toString(TrackShape shape);
+/// The command line's spelling of each shape, profile and heading mode (parseEnum reads it).
+inline constexpr EnumName<TrackShape> kTrackShapeNames[] = {
+    {TrackShape::kCircle, "circle"}, {TrackShape::kEight, "eight"}, {TrackShape::kLine, "line"},
+    {TrackShape::kSpin, "spin"}};
+inline const char* toString(TrackShape shape) { return enumName(kTrackShapeNames, shape); }
+inline constexpr EnumName<ClimbProfile> kClimbProfileNames[] = {
+    {ClimbProfile::kRamp, "ramp"}, {ClimbProfile::kHill, "hill"}};
+inline constexpr EnumName<HeadingMode> kHeadingModeNames[] = {
+    {HeadingMode::kFixed, "fixed"}, {HeadingMode::kTrack, "track"}};
 
 }  // namespace sim
 }  // namespace oefmt
