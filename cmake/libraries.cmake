@@ -11,7 +11,6 @@
 
 function(oefmt_layer_library name folder)
   file(GLOB sources CONFIGURE_DEPENDS ${OEFMT_ROOT}/src/${folder}/*.cpp)
-  list(FILTER sources EXCLUDE REGEX "/yaml_(map|text)\\.cpp$")
   add_library(${name} ${sources})
   target_include_directories(${name} PUBLIC $<BUILD_INTERFACE:${OEFMT_ROOT}/include>)
   target_include_directories(${name} SYSTEM PUBLIC ${OpenCV_INCLUDE_DIRS})
@@ -31,13 +30,12 @@ target_link_libraries(oefmt_registration PUBLIC opencv_core opencv_imgproc PRIVA
 
 oefmt_layer_library(oefmt_estimation estimation)
 target_link_libraries(oefmt_estimation PUBLIC oefmt_registration Eigen3::Eigen Ceres::ceres)
-# The YAML reader still serves EstimatorConfig's loader until that moves to oefmt_io.
-target_sources(oefmt_estimation PRIVATE ${OEFMT_ROOT}/src/io/yaml_map.cpp ${OEFMT_ROOT}/src/io/yaml_text.cpp)
 
 oefmt_layer_library(oefmt_io io)
-# libspng decodes PNG files, OpenCV's imgcodecs the other formats (src/io/image_decoding.cpp).
+# libspng decodes PNG files, OpenCV's imgcodecs the other formats (src/io/image_decoding.cpp);
+# yaml-cpp reads the configuration file and cam_param.yaml (src/io/yaml_document.h).
 target_link_libraries(oefmt_io PUBLIC oefmt_estimation opencv_calib3d
-                               PRIVATE opencv_imgcodecs PkgConfig::SPNG)
+                               PRIVATE opencv_imgcodecs PkgConfig::SPNG yaml-cpp)
 
 oefmt_layer_library(oefmt_evaluation evaluation)
 target_link_libraries(oefmt_evaluation PUBLIC oefmt_io Eigen3::Eigen)

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Arbitrary bytes as a file -> readCameraParameters (a dataset's cam_param.yaml), the frames'
-// undistortion set up from what it accepted, and loadConfig (the estimator's YAML). Each must
-// either return checked values or throw its documented exception (DatasetError / InputError);
-// anything else escaping (cv::Exception, bad_alloc, ...) terminates the run and is a finding. An accepted configuration must survive a round trip
-// through configToYaml. OpenCV 4.6's YAML reader never returns on some malformed documents
-// (" e: 5\nabc-\n\n", "---e:x\nlt\n-\n"): scripts/hardening.sh runs this target in fork mode and
-// tells such timeouts (stack inside cv::FileStorage) from hangs of ours.
+// undistortion set up from what it accepted, and loadConfig (the configuration file). Both read
+// through yaml-cpp. Each must either return checked values or throw its documented exception
+// (DatasetError / InputError); anything else escaping (YAML::Exception, bad_alloc, ...)
+// terminates the run and is a finding. An accepted configuration must survive a round trip
+// through configToYaml. The corpus keeps the documents on which OpenCV's YAML reader, used
+// before, never returned; scripts/hardening.sh runs this target in fork mode and replays any
+// timeout.
 #include <unistd.h>
 
 #include <cmath>
@@ -19,6 +20,7 @@
 #include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "oefmt/io/config_file.h"
 #include "oefmt/io/undistortion.h"
 
 namespace {

@@ -93,7 +93,8 @@ Camera.height: 3040""")
     write("fuzz_cam_param", "config.yaml", b"""%YAML 1.0
 ---
 mode: efmt
-altitude: 12.5
+initial_altitude: 12.5
+camera_fx: 450.0
 registration:
   size: 128
   block_radius: 3

@@ -113,8 +113,8 @@ cases=()
 if [ $built = 1 ]; then
   section "Fuzz: ${seconds}s per target, up to $jobs at a time"
   # Fork mode: a timeout does not end the run; each one is replayed afterwards, and one that
-  # hangs again fails (parameter files no longer go through OpenCV's YAML reader, which looped
-  # forever on some documents; see include/oefmt/io/yaml_map.h).
+  # hangs again fails (parameter files are read by yaml-cpp, no longer by OpenCV's YAML reader,
+  # which looped forever on some documents kept in the corpus).
   # OPENCV_IO_MAX_IMAGE_PIXELS: OpenCV reads it at load time; it refuses images that claim
   # gigapixels, which would otherwise only measure the fuzzer's memory limit.
   fuzz_env=(OPENCV_IO_MAX_IMAGE_PIXELS=4194304 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1

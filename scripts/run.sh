@@ -17,7 +17,7 @@ packages=(
   libcv-bridge-dev libimage-geometry-dev libimage-transport-dev libtf2-ros-dev libtf2-geometry-msgs-dev librosbag-dev
   ros-nav-msgs ros-sensor-msgs ros-geometry-msgs ros-message-generation ros-message-runtime
   libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev libspng-dev
-  libcli11-dev zlib1g-dev
+  libcli11-dev zlib1g-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch python3-rosbag
   rosbash python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs
   python3-tf2-ros python3-diagnostic-msgs python3-numpy python3-matplotlib

@@ -80,7 +80,7 @@ struct Estimator::State {
         registrar(std::move(context)),
         registrar02(registrar.sharedContext()),
         optimizer(c.optimizer),
-        integrator(c.initialAltitude(), c.effectiveFx()),
+        integrator(c.initialAltitudeOrOne(), c.effectiveFx()),
         multi_zoom(registrar.sharedContext(), c.efmt) {
     // A pair 0-2 that does not register only costs this frame its loop: the further rotation/zoom
     // candidates (up to 4 more registrations, on the tail latency) are kept for pair 1-2.
@@ -268,7 +268,7 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
       prior.translation += rotateImageVector(start->translation, rotation12) * std::exp(log_zoom12);
       uncertainty += std::sqrt(std::max(cv::trace(start->translation_covariance), 0.0));
     }
-    const double metres = config.altitude > 0.0 ? integrator.altitude()
+    const double metres = config.initial_altitude > 0.0 ? integrator.altitude()
                                                 : config.tracking.assumed_altitude * integrator.altitude();
     prior.translation_radius = config.effectiveFx() * config.tracking.max_acceleration * seconds * seconds /
                                    std::max(metres, 1e-6) +

@@ -2,312 +2,251 @@
 #include "oefmt/estimation/estimator_config.h"
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <functional>
-#include <iterator>
-#include <set>
-#include <sstream>
-#include <vector>
 
 #include "oefmt/error.h"
-#include "oefmt/io/yaml_map.h"
 
 namespace oefmt {
+
+const std::vector<ParameterSection>& estimatorParameterSections() {
+  static const std::vector<ParameterSection> sections = {
+      {"", "Method, scale and camera"},
+      {"registration", "Pair registration (spectral rotation, zoom and translation of two frames)"},
+      {"matching", "Pattern matching of energy vectors (PMT: stretch of the translation energy, "
+                   "PMS: shift of the zoom energy)"},
+      {"optimizer", "Local optimizer (Ceres over the loop 0-1, 1-2, 0-2 of the three-frame window)"},
+      {"tracking", "Depth-layer following and failure handling"},
+      {"uncertainty", "Measurement uncertainty (errors as fractions of the registration's peak widths)"},
+      {"efmt", "efmt mode only: multi-zoom translation of the original eFMT"},
+  };
+  return sections;
+}
+
+ParameterTable estimatorParameters(EstimatorConfig& c) {
+  RegistrationConfig& r = c.registration;
+  MatchingConfig& m = c.matching;
+  LocalOptimizerOptions& o = c.optimizer;
+  TrackingConfig& t = c.tracking;
+  UncertaintyConfig& u = c.uncertainty;
+  EfmtConfig& e = c.efmt;
+  ParameterTable table = {
+      wordParameter("mode", c.mode, kEstimatorModeNames,
+                    "oefmt: three-frame energy-vector estimator with pattern matching and local "
+                    "optimizer; efmt: the original multi-zoom eFMT on consecutive pairs; fmt: classic "
+                    "single-peak Fourier-Mellin on consecutive pairs"),
+      numberParameter("initial_altitude", c.initial_altitude, "m", atLeast(0.0),
+                      "altitude of the first frame above the dominant plane: the poses are in metres; "
+                      "0 = unknown, the poses are in units of this altitude"),
+      numberParameter("camera_fx", c.camera_fx, "px", atLeast(0.0),
+                      "focal length of the input images in their pixels, for frames that come without "
+                      "a calibration (cam_param.yaml, camera_info); 0 = unknown (oefmt_offline then "
+                      "assumes a 53 degree field of view, the node waits for camera_info)"),
+      booleanParameter("parallel_registrations", c.parallel_registrations,
+                       "run the two registrations of a frame (pairs 1-2 and 0-2) on two threads; false "
+                       "keeps the estimator on one core"),
+
+      integerParameter("registration.size", r.size, "px", [] {
+        ParameterRange even = atLeast(64);
+        even.even = true;
+        return even;
+      }(), "working image size N: frames are centre-cropped to a square and resized to N x N "
+           "(at most the frames' shorter side: upscaled frames register worse)"),
+      numberParameter("registration.taper_fraction", r.taper_fraction, "", closedRange(0.0, 0.5),
+                      "apodization taper width as a fraction of N"),
+      numberParameter("registration.logpolar_radius_fraction", r.logpolar_radius_fraction, "",
+                      [] {
+                        ParameterRange range = closedRange(0.05, 0.75);
+                        range.min_open = true;
+                        return range;
+                      }(),
+                      "largest log-polar radius as a fraction of N; sets the log-zoom bin "
+                      "ln b = ln(fraction N) / N"),
+      numberParameter("registration.polar_radius_fraction", r.polar_radius_fraction, "px per bin",
+                      [] {
+                        ParameterRange range = closedRange(0.05, 1.0);
+                        range.min_open = true;
+                        return range;
+                      }(),
+                      "radius step of the translation polar unwrap (translation energy bin j is a "
+                      "shift of j times this)"),
+      integerParameter("registration.block_radius", r.block_radius, "rows", closedRange(0, 10),
+                       "energy rows fused on each side of the energy peak"),
+      numberParameter("registration.energy_smoothing_sigma", r.energy_smoothing_sigma, "bins",
+                      closedRange(0.0, 10.0), "Gaussian smoothing of the energy vectors; 0 = off"),
+      booleanParameter("registration.resolve_half_turn", r.resolve_half_turn,
+                       "tell theta from theta + 180 degrees by the translation peak"),
+      numberParameter("registration.min_texture", r.min_texture, "grey std (0..1)", atLeast(0.0),
+                      "frames with less texture are textureless"),
+      numberParameter("registration.min_confidence", r.min_confidence, "", closedRange(0.0, 1.0),
+                      "registrations with a lower confidence are not used (the frame is predicted or held)"),
+      integerParameter("registration.rotation_zoom_candidates", r.rotation_zoom_candidates, "",
+                       closedRange(1, 10),
+                       "rotation/zoom correlation peaks tried, highest first, while the registration "
+                       "stays below min_confidence (pair 0-2 tries only the highest); 1 = only the highest"),
+      numberParameter("registration.identity_warp_px", r.identity_warp_px, "px", closedRange(0.0, 1.0),
+                      "a rotation/zoom that moves no image corner further counts as the identity: the "
+                      "cached spectrum is correlated without a warp and its FFT; 0 = always warp"),
+      booleanParameter("registration.noise_weighting", r.noise_weighting,
+                       "weight each frequency of the translation correlation by its share of signal "
+                       "(sensor noise estimated from the spectrum's outer ring)"),
+      wordParameter("registration.fft_planning", r.fft_planning, kFftPlanningNames,
+                    "FFTW planning effort, paid once per size and machine (plans are kept as FFTW "
+                    "wisdom); patient plans the fastest FFTs"),
+
+      integerParameter("matching.stretch_steps", m.stretch_steps, "", closedRange(2, 1000),
+                       "PMT candidates exp(m key / 1000), m = -steps .. steps"),
+      numberParameter("matching.stretch_key_12", m.stretch_key_12, "per mille of ln",
+                      closedRange(1.0, 100.0), "PMT candidate spacing, pair 0-1 against pair 1-2"),
+      numberParameter("matching.stretch_key_02", m.stretch_key_02, "per mille of ln",
+                      closedRange(1.0, 100.0), "PMT candidate spacing, pair 0-1 against pair 0-2"),
+      numberParameter("matching.stretch_init_window", m.stretch_init_window, "", closedRange(0.05, 10.0),
+                      "PMT factors must lie within this of the expected one (1 for 1-2, 2 for 0-2 at "
+                      "equal frame spacing)"),
+      numberParameter("matching.max_normalised_error", m.max_normalised_error, "", closedRange(0.01, 1.0),
+                      "a match qualifies when its error is below this fraction of the error range"),
+      numberParameter("matching.smoothing_sigma", m.smoothing_sigma, "bins", closedRange(0.0, 10.0),
+                      "Gaussian smoothing of both vectors before matching; 0 = off"),
+      numberParameter("matching.stretch_sigma_floor", m.stretch_sigma_floor, "relative",
+                      closedRange(1e-6, 1.0), "smallest PMT sigma"),
+      numberParameter("matching.shift_range", m.shift_range, "bins", closedRange(1.0, 200.0),
+                      "PMS search range (plus or minus)"),
+      numberParameter("matching.shift_step", m.shift_step, "bins", closedRange(0.001, 0.5),
+                      "PMS resolution"),
+      numberParameter("matching.shift_sigma_floor", m.shift_sigma_floor, "bins", closedRange(1e-6, 10.0),
+                      "smallest PMS sigma"),
+      numberParameter("matching.min_peak_bins", m.min_peak_bins, "bins", closedRange(0.0, 100.0),
+                      "PMT needs the previous shift beyond this many translation bins (a hovering "
+                      "camera has nothing to stretch)"),
+      integerParameter("matching.skip_bins", m.skip_bins, "bins", closedRange(0, 100),
+                       "cleared before PMT when the previous shift is beyond 4 times as many (the "
+                       "no-motion peak of static patterns must not decide the stretch)"),
+
+      integerParameter("optimizer.max_iterations", o.max_iterations, "", closedRange(1, 1000),
+                       "Levenberg-Marquardt iterations (DENSE_QR, 8 parameters)"),
+      wordParameter("optimizer.robust_loss", o.robust_loss, kRobustLossNames,
+                    "robust loss of each observation block (the loop blocks use huber unless none)"),
+      numberParameter("optimizer.loss_scale", o.loss_scale, "sigmas", above(0.0),
+                      "residual where the loss turns robust"),
+      numberParameter("optimizer.loop_translation_sigma", o.loop_translation_sigma, "px", above(0.0),
+                      "floor of the translation loop's sigma"),
+      numberParameter("optimizer.loop_translation_sigma_relative", o.loop_translation_sigma_relative,
+                      "relative", atLeast(0.0), "plus this fraction of the loop's path length"),
+      numberParameter("optimizer.loop_rotation_sigma", o.loop_rotation_sigma, "rad", above(0.0),
+                      "floor of the rotation loop's sigma"),
+      numberParameter("optimizer.loop_log_zoom_sigma", o.loop_log_zoom_sigma, "ln zoom", above(0.0),
+                      "floor of the log-zoom loop's sigma (the zoom biases of pairs with different "
+                      "baselines differ by about this much)"),
+      numberParameter("optimizer.function_tolerance", o.function_tolerance, "relative",
+                      [] {
+                        ParameterRange range = closedRange(0.0, 1.0);
+                        range.min_open = range.max_open = true;
+                        return range;
+                      }(),
+                      "cost change (and step) that counts as converged"),
+
+      numberParameter("tracking.layer_gate", t.layer_gate, "relative", closedRange(0.001, 1.0),
+                      "a correlation peak whose length differs from the PMT prediction by more belongs "
+                      "to another depth layer (or is an alias): only its direction is used"),
+      numberParameter("tracking.layer_search", t.layer_search, "relative", closedRange(0.001, 1.0),
+                      "window around the prediction where the followed layer's translation energy "
+                      "peak is searched"),
+      numberParameter("tracking.layer_min_fraction", t.layer_min_fraction, "", closedRange(0.0, 1.0),
+                      "that peak must reach this fraction of the translation energy maximum"),
+      numberParameter("tracking.steady_layer_min_fraction", t.steady_layer_min_fraction, "",
+                      closedRange(0.0, 1.0),
+                      "a step off steady speed by more than layer_gate moves to a translation energy "
+                      "peak at the steady length when that peak reaches this fraction of the maximum; "
+                      "1 = only the largest peak"),
+      integerParameter("tracking.max_failed_frames", t.max_failed_frames, "frames", closedRange(0, 1000),
+                       "frames in a row that may fail to register before the window restarts from "
+                       "the newest"),
+      booleanParameter("tracking.predict_failed_frames", t.predict_failed_frames,
+                       "predict failed frames with the last motion (else hold the pose)"),
+      numberParameter("tracking.prediction_sigma", t.prediction_sigma, "relative", closedRange(0.0, 100.0),
+                      "sigma of a predicted step's length"),
+      numberParameter("tracking.motion_prior_sigma", t.motion_prior_sigma, "relative",
+                      closedRange(0.0, 100.0),
+                      "sigma of the weak prior that a pair continues the previous motion (breaks ties "
+                      "between an aliased correlation peak and the loop); 0 = off"),
+      numberParameter("tracking.max_acceleration", t.max_acceleration, "m/s^2", closedRange(0.01, 1000.0),
+                      "largest acceleration of the vehicle: how far the next translation peak may lie "
+                      "from the motion so far (fx a dt^2 / altitude px); a weaker peak inside that "
+                      "window is accepted, an alias outside it is not taken at full confidence"),
+      numberParameter("tracking.assumed_altitude", t.assumed_altitude, "m", closedRange(0.01, 1e5),
+                      "distance to the scene the acceleration window assumes when the altitude is "
+                      "unknown: low on purpose, which makes the window wide rather than wrong"),
+
+      numberParameter("uncertainty.rotation_scale", u.rotation_scale, "", closedRange(1e-4, 100.0),
+                      "rotation error per rotation peak width"),
+      numberParameter("uncertainty.log_zoom_scale", u.log_zoom_scale, "", closedRange(1e-4, 100.0),
+                      "log-zoom error per zoom peak width"),
+      numberParameter("uncertainty.shift_scale", u.shift_scale, "", closedRange(1e-4, 100.0),
+                      "translation error along the motion per shift peak width"),
+      numberParameter("uncertainty.direction_scale", u.direction_scale, "", closedRange(1e-4, 100.0),
+                      "translation error across the motion per (shift times direction peak width)"),
+
+      integerParameter("efmt.zoom_samples", e.zoom_samples, "", closedRange(1, 50),
+                       "zoom hypotheses sampled between the least and the most significant zoom"),
+      numberParameter("efmt.zoom_threshold", e.zoom_threshold, "", closedRange(0.0, 1.0),
+                      "significant zoom energy, as a fraction of its peak"),
+      integerParameter("efmt.sector_half_width", e.sector_half_width, "rows", closedRange(0, 64),
+                       "half width of the direction sector (one row is 2 pi / N rad)"),
+  };
+  return table;
+}
+
+std::string retiredParameterHint(const std::string& key) {
+  if (key == "altitude") return "renamed initial_altitude";
+  if (key == "fx") {
+    return "replaced by camera_fx: the focal length of the input images in their own pixels, where "
+           "fx was the working image's";
+  }
+  return "";
+}
+
 namespace {
 
-bool finiteIn(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
-
-// ---- reading one value -------------------------------------------------------------------
-
-[[noreturn]] void badValue(const std::string& key, const std::string& expected) {
-  throw InputError("invalid parameter '" + key + "': expected " + expected);
-}
-
-std::string trimmed(const std::string& s) {
-  const auto first = s.find_first_not_of(" \t");
-  if (first == std::string::npos) return "";
-  return s.substr(first, s.find_last_not_of(" \t") - first + 1);
-}
-
-// Values are text (parseYaml keeps scalars as written); numbers, integers, booleans and words
-// are told apart here, with the key in the message.
-const std::string& scalarOf(const YamlNode& node, const std::string& key, const std::string& expected) {
-  if (node.is_map) badValue(key, expected + ", not a map");
-  return node.scalar;
-}
-
-double readDouble(const YamlNode& node, const std::string& key) {
-  bool out_of_range = false;
-  const std::optional<double> v = yamlNumber(trimmed(scalarOf(node, key, "a number")), &out_of_range);
-  if (!v || out_of_range) badValue(key, "a number");
-  return *v;
-}
-
-int readInt(const YamlNode& node, const std::string& key) {
-  const double v = readDouble(node, key);
-  if (!(std::fabs(v) < 1e9) || v != std::floor(v)) badValue(key, "an integer");
-  return static_cast<int>(v);
-}
-
-bool readBool(const YamlNode& node, const std::string& key) {
-  const std::string text = trimmed(scalarOf(node, key, "true or false"));
-  if (text == "true" || text == "True" || text == "TRUE" || text == "yes" || text == "on" || text == "1") return true;
-  if (text == "false" || text == "False" || text == "FALSE" || text == "no" || text == "off" || text == "0") return false;
-  badValue(key, "true or false");
-}
-
-std::string readString(const YamlNode& node, const std::string& key) {
-  return trimmed(scalarOf(node, key, "a word"));
-}
-
-// One of an enum's words (its name table), the message listing them.
-template <typename T, std::size_t N>
-T readWord(const YamlNode& node, const std::string& key, const EnumName<T> (&names)[N]) {
-  const std::optional<T> value = findEnum(names, readString(node, key));
-  if (!value) badValue(key, wordList(enumNames(names)));
-  return *value;
-}
-
-// ---- writing one value -------------------------------------------------------------------
-
-// A double that both OpenCV and PyYAML read back as a number (YAML 1.1 wants a dot).
-std::string formatDouble(double v) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.10g", v);
-  std::string s = buffer;
-  if (s.find_first_of(".ein") == std::string::npos) return s + ".0";
-  const auto e = s.find('e');
-  if (e != std::string::npos && s.find('.') == std::string::npos) s.insert(e, ".0");
-  return s;
-}
-
-// ---- the parameter table -----------------------------------------------------------------
-
-struct Field {
-  std::string key;  // within its section
-  std::function<void(const YamlNode&, const std::string&)> read;
-  std::function<std::string()> write;
-};
-
-struct Section {
-  std::string name;  // "" for the top level
-  std::vector<Field> fields;
-  std::function<void()> validate;
-};
-
-Field number(const std::string& key, double& target) {
-  return {key, [&target](const YamlNode& n, const std::string& k) { target = readDouble(n, k); },
-          [&target] { return formatDouble(target); }};
-}
-Field integer(const std::string& key, int& target) {
-  return {key, [&target](const YamlNode& n, const std::string& k) { target = readInt(n, k); },
-          [&target] { return std::to_string(target); }};
-}
-Field boolean(const std::string& key, bool& target) {
-  return {key, [&target](const YamlNode& n, const std::string& k) { target = readBool(n, k); },
-          [&target] { return std::string(target ? "true" : "false"); }};
-}
-
-template <typename T, std::size_t N>
-Field word(const std::string& key, T& target, const EnumName<T> (&names)[N]) {
-  return {key, [&target, &names](const YamlNode& n, const std::string& k) { target = readWord(n, k, names); },
-          [&target, &names] { return std::string(enumName(names, target)); }};
-}
-
-std::vector<Section> sections(EstimatorConfig& c) {
-  std::vector<Section> all;
-  all.push_back({"",
-                 {word("mode", c.mode, kEstimatorModeNames),
-                  number("altitude", c.altitude), number("fx", c.fx),
-                  boolean("parallel_registrations", c.parallel_registrations)},
-                 [&c] {
-                   requireParameter(std::isfinite(c.altitude) && c.altitude >= 0.0, "altitude",
-                                    "must be >= 0 m (0 = unknown)");
-                   requireParameter(std::isfinite(c.fx) && c.fx >= 0.0, "fx", "must be >= 0 px (0 = size)");
-                 }});
-  RegistrationConfig& r = c.registration;
-  all.push_back({"registration",
-                 {integer("size", r.size), number("taper_fraction", r.taper_fraction),
-                  number("logpolar_radius_fraction", r.logpolar_radius_fraction),
-                  number("polar_radius_fraction", r.polar_radius_fraction),
-                  integer("block_radius", r.block_radius),
-                  number("energy_smoothing_sigma", r.energy_smoothing_sigma),
-                  boolean("resolve_half_turn", r.resolve_half_turn),
-                  number("min_texture", r.min_texture), number("min_confidence", r.min_confidence),
-                  integer("rotation_zoom_candidates", r.rotation_zoom_candidates),
-                  number("identity_warp_px", r.identity_warp_px),
-                  boolean("noise_weighting", r.noise_weighting),
-                  word("fft_planning", r.fft_planning, kFftPlanningNames)},
-                 [&r] { r.validate(); }});
-  MatchingConfig& m = c.matching;
-  all.push_back({"matching",
-                 {integer("stretch_steps", m.stretch_steps),
-                  number("stretch_key_12", m.stretch_key_12),
-                  number("stretch_key_02", m.stretch_key_02),
-                  number("stretch_init_window", m.stretch_init_window),
-                  number("max_normalised_error", m.max_normalised_error),
-                  number("smoothing_sigma", m.smoothing_sigma),
-                  number("stretch_sigma_floor", m.stretch_sigma_floor),
-                  number("shift_range", m.shift_range), number("shift_step", m.shift_step),
-                  number("shift_sigma_floor", m.shift_sigma_floor),
-                  number("min_peak_bins", m.min_peak_bins), integer("skip_bins", m.skip_bins)},
-                 [&m] { m.validate(); }});
-  LocalOptimizerOptions& o = c.optimizer;
-  all.push_back({"optimizer",
-                 {integer("max_iterations", o.max_iterations),
-                  word("robust_loss", o.robust_loss, kRobustLossNames),
-                  number("loss_scale", o.loss_scale),
-                  number("loop_translation_sigma", o.loop_translation_sigma),
-                  number("loop_translation_sigma_relative", o.loop_translation_sigma_relative),
-                  number("loop_rotation_sigma", o.loop_rotation_sigma),
-                  number("loop_log_zoom_sigma", o.loop_log_zoom_sigma),
-                  number("function_tolerance", o.function_tolerance)},
-                 [&o] { o.validate(); }});
-  TrackingConfig& t = c.tracking;
-  all.push_back({"tracking",
-                 {number("layer_gate", t.layer_gate), number("layer_search", t.layer_search),
-                  number("layer_min_fraction", t.layer_min_fraction),
-                  number("steady_layer_min_fraction", t.steady_layer_min_fraction),
-                  integer("max_failed_frames", t.max_failed_frames),
-                  boolean("predict_failed_frames", t.predict_failed_frames),
-                  number("prediction_sigma", t.prediction_sigma),
-                  number("motion_prior_sigma", t.motion_prior_sigma),
-                  number("max_acceleration", t.max_acceleration),
-                  number("assumed_altitude", t.assumed_altitude)},
-                 [&t] { t.validate(); }});
-  UncertaintyConfig& u = c.uncertainty;
-  all.push_back({"uncertainty",
-                 {number("rotation_scale", u.rotation_scale),
-                  number("log_zoom_scale", u.log_zoom_scale), number("shift_scale", u.shift_scale),
-                  number("direction_scale", u.direction_scale)},
-                 [&u] { u.validate(); }});
-  EfmtConfig& e = c.efmt;
-  all.push_back({"efmt",
-                 {integer("zoom_samples", e.zoom_samples), number("zoom_threshold", e.zoom_threshold),
-                  integer("sector_half_width", e.sector_half_width)},
-                 [&e] { e.validate(); }});
-  return all;
-}
-
-// Reads the fields of one map node; unknown keys are errors (a typo must not pass silently).
-void readSection(const Section& section, const YamlNode& node, const std::string& prefix) {
-  std::set<std::string> known;
-  for (const Field& f : section.fields) known.insert(f.key);
-  for (const auto& [name, child] : node.children) {
-    if (prefix.empty() && child.is_map) continue;  // a section, read separately
-    if (known.count(name) == 0) throw InputError("unknown parameter '" + prefix + name + "'");
-  }
-  for (const Field& f : section.fields) {
-    const YamlNode* child = node.find(f.key);
-    if (child == nullptr || child->is_null) continue;
-    f.read(*child, prefix + f.key);
-  }
-}
-
-void validateSection(const Section& section) {
-  try {
-    section.validate();
-  } catch (const InputError& e) {
-    if (section.name.empty()) throw;
-    throw InputError(section.name + ": " + e.what());
-  }
+// Checks the rows of one section of `config` (the struct's own validate()).
+void checkSection(EstimatorConfig config, const std::string& section) {
+  checkParameters(estimatorParameters(config), section + ".");
 }
 
 }  // namespace
 
 void MatchingConfig::validate() const {
-  requireParameter(stretch_steps >= 2 && stretch_steps <= 1000, "stretch_steps", "must be in [2, 1000]");
-  requireParameter(finiteIn(stretch_key_12, 1.0, 100.0), "stretch_key_12", "must be in [1, 100] per mille");
-  requireParameter(finiteIn(stretch_key_02, 1.0, 100.0), "stretch_key_02", "must be in [1, 100] per mille");
-  requireParameter(finiteIn(stretch_init_window, 0.05, 10.0), "stretch_init_window", "must be in [0.05, 10]");
-  requireParameter(finiteIn(max_normalised_error, 0.01, 1.0), "max_normalised_error", "must be in [0.01, 1]");
-  requireParameter(finiteIn(smoothing_sigma, 0.0, 10.0), "smoothing_sigma", "must be in [0, 10] bins");
-  requireParameter(finiteIn(stretch_sigma_floor, 1e-6, 1.0), "stretch_sigma_floor", "must be in [1e-6, 1]");
-  requireParameter(finiteIn(shift_range, 1.0, 200.0), "shift_range", "must be in [1, 200] bins");
-  requireParameter(finiteIn(shift_step, 0.001, 0.5), "shift_step", "must be in [0.001, 0.5] bins");
-  requireParameter(finiteIn(shift_sigma_floor, 1e-6, 10.0), "shift_sigma_floor", "must be in [1e-6, 10] bins");
-  requireParameter(finiteIn(min_peak_bins, 0.0, 100.0), "min_peak_bins", "must be in [0, 100] bins");
-  requireParameter(skip_bins >= 0 && skip_bins <= 100, "skip_bins", "must be in [0, 100] bins");
+  EstimatorConfig c;
+  c.matching = *this;
+  checkSection(c, "matching");
 }
 
 void TrackingConfig::validate() const {
-  requireParameter(finiteIn(layer_gate, 0.001, 1.0), "layer_gate", "must be in [0.001, 1]");
-  requireParameter(finiteIn(layer_search, 0.001, 1.0), "layer_search", "must be in [0.001, 1]");
-  requireParameter(finiteIn(layer_min_fraction, 0.0, 1.0), "layer_min_fraction", "must be in [0, 1]");
-  requireParameter(finiteIn(steady_layer_min_fraction, 0.0, 1.0), "steady_layer_min_fraction", "must be in [0, 1]");
-  requireParameter(max_failed_frames >= 0 && max_failed_frames <= 1000, "max_failed_frames", "must be in [0, 1000]");
-  requireParameter(finiteIn(prediction_sigma, 0.0, 100.0), "prediction_sigma", "must be in [0, 100]");
-  requireParameter(finiteIn(motion_prior_sigma, 0.0, 100.0), "motion_prior_sigma", "must be in [0, 100]");
-  requireParameter(finiteIn(max_acceleration, 0.01, 1000.0), "max_acceleration", "must be in [0.01, 1000] m/s^2");
-  requireParameter(finiteIn(assumed_altitude, 0.01, 1e5), "assumed_altitude", "must be in [0.01, 1e5] m");
+  EstimatorConfig c;
+  c.tracking = *this;
+  checkSection(c, "tracking");
 }
 
 void UncertaintyConfig::validate() const {
-  requireParameter(finiteIn(rotation_scale, 1e-4, 100.0), "rotation_scale", "must be in [1e-4, 100]");
-  requireParameter(finiteIn(log_zoom_scale, 1e-4, 100.0), "log_zoom_scale", "must be in [1e-4, 100]");
-  requireParameter(finiteIn(shift_scale, 1e-4, 100.0), "shift_scale", "must be in [1e-4, 100]");
-  requireParameter(finiteIn(direction_scale, 1e-4, 100.0), "direction_scale", "must be in [1e-4, 100]");
+  EstimatorConfig c;
+  c.uncertainty = *this;
+  checkSection(c, "uncertainty");
 }
 
 void EfmtConfig::validate() const {
-  requireParameter(zoom_samples >= 1 && zoom_samples <= 50, "zoom_samples", "must be in [1, 50]");
-  requireParameter(finiteIn(zoom_threshold, 0.0, 1.0), "zoom_threshold", "must be in [0, 1]");
-  requireParameter(sector_half_width >= 0 && sector_half_width <= 64, "sector_half_width", "must be in [0, 64]");
+  EstimatorConfig c;
+  c.efmt = *this;
+  checkSection(c, "efmt");
 }
 
 void EstimatorConfig::validate() const {
   EstimatorConfig copy = *this;
-  for (const Section& section : sections(copy)) validateSection(section);
-}
-
-EstimatorConfig parseConfig(const YamlNode& root, const std::string& source) {
-  EstimatorConfig config;
-  try {
-    if (!root.is_map) throw InputError("expected a map of parameters at the top level");
-    const std::vector<Section> all = sections(config);
-    std::set<std::string> section_names;
-    for (const Section& s : all) section_names.insert(s.name);
-    for (const auto& [name, child] : root.children) {
-      if (child.is_map && section_names.count(name) == 0) {
-        throw InputError("unknown parameter section '" + name + "'");
-      }
-    }
-    for (const Section& s : all) {
-      if (s.name.empty()) {
-        readSection(s, root, "");
-        continue;
-      }
-      const YamlNode* node = root.find(s.name);
-      if (node == nullptr || node->is_null) continue;
-      if (!node->is_map) throw InputError("parameter section '" + s.name + "' must be a map");
-      readSection(s, *node, s.name + ".");
-    }
-    for (const Section& s : all) validateSection(s);
-  } catch (const InputError& e) {
-    throw InputError(source + ": " + e.what());
+  checkParameters(estimatorParameters(copy));
+  if (!(std::isfinite(working_fx) && working_fx >= 0.0)) {
+    throw InputError("the working image's focal length must be >= 0 px (0 = unknown), got " +
+                     std::to_string(working_fx));
   }
-  return config;
-}
-
-EstimatorConfig loadConfig(const std::string& yaml_path) {
-  std::ifstream in(yaml_path, std::ios::binary);
-  if (!in) throw InputError("cannot open configuration file '" + yaml_path + "'");
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) throw InputError("cannot read configuration file '" + yaml_path + "'");
-  return parseConfig(parseYaml(text, "configuration file '" + yaml_path + "'"), yaml_path);
-}
-
-std::string configToYaml(const EstimatorConfig& config) {
-  EstimatorConfig copy = config;
-  std::ostringstream out;
-  out << "%YAML 1.0\n---\n";
-  for (const Section& s : sections(copy)) {
-    const std::string indent = s.name.empty() ? "" : "  ";
-    if (!s.name.empty()) out << s.name << ":\n";
-    for (const Field& f : s.fields) out << indent << f.key << ": " << f.write() << "\n";
-  }
-  return out.str();
+  // The registration's and the optimizer's own checks (their libraries run them too): the table
+  // gives the same rules, which a test compares.
+  registration.validate();
+  optimizer.validate();
 }
 
 }  // namespace oefmt

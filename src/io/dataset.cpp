@@ -10,10 +10,9 @@
 #include <sstream>
 #include <utility>
 
-
 #include "oefmt/error.h"
 #include "oefmt/io/image_decoding.h"
-#include "oefmt/io/yaml_map.h"
+#include "yaml_document.h"
 
 namespace oefmt {
 namespace fs = std::filesystem;
@@ -58,18 +57,27 @@ std::string readWholeFile(const std::string& path) {
   return text.str();
 }
 
-// Reads Camera.<key> as a number; `fallback` when absent and not required.
-double readNumber(const YamlNode& root, const std::string& path, const char* key, bool required,
+// Camera.<key>'s node; an undefined node when the file has no such key.
+YAML::Node cameraKey(const YAML::Node& root, const char* key) {
+  const YAML::Node& map = root;  // const: operator[] must not add the key
+  return map[std::string("Camera.") + key];
+}
+
+// Reads Camera.<key> as a number; `fallback` when absent (or null) and not required.
+double readNumber(const YAML::Node& root, const std::string& path, const char* key, bool required,
                   double fallback) {
-  const YamlNode* node = root.find(std::string("Camera.") + key);
-  if (node == nullptr || node->is_null) {
+  const YAML::Node node = cameraKey(root, key);
+  if (!node.IsDefined() || node.IsNull()) {
     if (required) throw DatasetError("'" + path + "' has no Camera." + key);
     return fallback;
   }
-  const std::optional<double> value = node->is_map ? std::nullopt : yamlNumber(node->scalar);
-  if (!value) throw DatasetError("'" + path + "': Camera." + key + " is not a number");
-  if (!std::isfinite(*value)) throw DatasetError("'" + path + "': Camera." + key + " is not finite");
-  return *value;
+  const std::string where = yamlWhere("'" + path + "'", node);
+  double value = 0.0;
+  if (!node.IsScalar() || !yamlNumber(node.Scalar(), value)) {
+    throw DatasetError(where + ": Camera." + key + " is not a number");
+  }
+  if (!std::isfinite(value)) throw DatasetError(where + ": Camera." + key + " is not finite");
+  return value;
 }
 
 bool isImageFile(const fs::path& path) {
@@ -108,9 +116,9 @@ std::string Distortion::text() const {
 }
 
 CameraParameters readCameraParameters(const std::string& path) {
-  YamlNode root;
+  YAML::Node root;
   try {
-    root = parseYaml(readWholeFile(path), "camera parameters '" + path + "'");
+    root = parseYamlMap(readWholeFile(path), "camera parameters '" + path + "'");
   } catch (const InputError& e) {
     throw DatasetError(e.what());
   }
@@ -124,9 +132,9 @@ CameraParameters readCameraParameters(const std::string& path) {
   k.height = static_cast<int>(std::lround(readNumber(root, path, "height", false, 0.0)));
   if (!(k.fx > 0.0 && k.fy > 0.0)) throw DatasetError("'" + path + "': Camera.fx and fy must be > 0");
   if (k.width < 0 || k.height < 0) throw DatasetError("'" + path + "': negative Camera.width/height");
-  const YamlNode* type = root.find("Camera.type");
-  if (type != nullptr && !type->is_null && !type->is_map && !isPinhole(type->scalar)) {
-    throw DatasetError("'" + path + "': Camera.type '" + type->scalar +
+  const YAML::Node type = cameraKey(root, "type");
+  if (type.IsDefined() && type.IsScalar() && !isPinhole(type.Scalar())) {
+    throw DatasetError(yamlWhere("'" + path + "'", type) + ": Camera.type '" + type.Scalar() +
                        "' is not supported (PinHole: k1, k2, p1, p2, k3 and rational k4, k5, k6)");
   }
   Distortion& d = camera.distortion;

@@ -14,11 +14,12 @@
 #include <tf2/LinearMath/Quaternion.h>
 
 #include "oefmt/EnergyVectors.h"
+#include "oefmt/io/config_file.h"
 #include "oefmt/error.h"
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/ros/estimate_messages.h"
-#include "oefmt/ros/parameter_yaml.h"
+#include "oefmt/ros/parameter_server.h"
 #include "oefmt/estimation/pose.h"
 #include "oefmt/io/undistortion.h"
 #include "oefmt/io/fft_wisdom.h"
@@ -30,24 +31,6 @@ namespace {
 constexpr double kWarnPeriod = 5.0;  // [s] between repeats of a per-frame warning
 constexpr size_t kLatencyWindow = 200;  // frames in the latency statistics
 
-template <typename T>
-T param(const ros::NodeHandle& nh, const std::string& key, const T& fallback) {
-  T value;
-  nh.param<T>(key, value, fallback);
-  return value;
-}
-
-[[noreturn]] void fatalParameter(const std::string& name, const std::string& key,
-                                 const std::string& rule) {
-  const std::string message = name + ": invalid parameter ~" + key + ": " + rule;
-  ROS_FATAL_STREAM(message);
-  throw InputError(message);
-}
-
-bool validFrameName(const std::string& frame) {
-  return !frame.empty() && frame[0] != '/' && frame.find(' ') == std::string::npos;
-}
-
 }  // namespace
 
 OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const std::string& name)
@@ -58,7 +41,6 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
       tf_listener_(tf_buffer_) {
   useDefaultFftWisdom();
   loadParameters();
-  estimator_config_ = loadEstimatorConfig();
   stamp_guard_ = StampGuard(parameters_.time_jump_tolerance);
   ROS_INFO_STREAM(name_ << ": effective estimator configuration:\n" << configToYaml(estimator_config_));
   {
@@ -120,48 +102,24 @@ OdometryRos::~OdometryRos() {
 }
 
 void OdometryRos::loadParameters() {
-  RosParameters& p = parameters_;
-  p.odom_frame = param(private_nh_, "odom_frame", p.odom_frame);
-  p.base_frame = param(private_nh_, "base_frame", p.base_frame);
-  p.camera_frame = param(private_nh_, "camera_frame", p.camera_frame);
-  p.publish_tf = param(private_nh_, "publish_tf", p.publish_tf);
-  p.compressed = param(private_nh_, "compressed", p.compressed);
-  p.queue_size = param(private_nh_, "queue_size", p.queue_size);
-  p.input_buffer = param(private_nh_, "input_buffer", p.input_buffer);
-  p.path_length = param(private_nh_, "path_length", p.path_length);
-  p.camera_fx = param(private_nh_, "camera_fx", p.camera_fx);
-  p.undistort = param(private_nh_, "undistort", p.undistort);
-  p.initial_altitude = param(private_nh_, "initial_altitude", p.initial_altitude);
-  p.use_altitude_topic = param(private_nh_, "use_altitude_topic", p.use_altitude_topic);
-  p.time_jump_tolerance = param(private_nh_, "time_jump_tolerance", p.time_jump_tolerance);
-  p.diagnostics_period = param(private_nh_, "diagnostics_period", p.diagnostics_period);
-  p.min_rate = param(private_nh_, "min_rate", p.min_rate);
-  p.max_rate = param(private_nh_, "max_rate", p.max_rate);
-
-  if (!validFrameName(p.odom_frame)) fatalParameter(name_, "odom_frame", "must be a non-empty frame name without a leading '/'");
-  if (!validFrameName(p.base_frame)) fatalParameter(name_, "base_frame", "must be a non-empty frame name without a leading '/'");
-  if (p.odom_frame == p.base_frame) fatalParameter(name_, "base_frame", "must differ from ~odom_frame");
-  if (!p.camera_frame.empty() && !validFrameName(p.camera_frame)) fatalParameter(name_, "camera_frame", "must not start with '/'");
-  if (p.queue_size < 1 || p.queue_size > 100) fatalParameter(name_, "queue_size", "must be in [1, 100]");
-  if (p.input_buffer < 1 || p.input_buffer > 100) fatalParameter(name_, "input_buffer", "must be in [1, 100]");
-  if (p.path_length < 0) fatalParameter(name_, "path_length", "must be >= 0");
-  if (!(p.camera_fx >= 0.0) || !std::isfinite(p.camera_fx)) fatalParameter(name_, "camera_fx", "must be >= 0 px (0: take it from camera_info)");
-  if (!(p.initial_altitude >= 0.0) || !std::isfinite(p.initial_altitude)) fatalParameter(name_, "initial_altitude", "must be >= 0 m (0: unknown)");
-  if (!(p.time_jump_tolerance > 0.0)) fatalParameter(name_, "time_jump_tolerance", "must be > 0 s");
-  if (!(p.diagnostics_period > 0.0)) fatalParameter(name_, "diagnostics_period", "must be > 0 s");
-  if (!(p.min_rate > 0.0) || !(p.max_rate >= p.min_rate)) fatalParameter(name_, "min_rate", "need 0 < min_rate <= max_rate");
-}
-
-EstimatorConfig OdometryRos::loadEstimatorConfig() {
-  // The estimator's parameters live in the same YAML file as oefmt_offline's, loaded into the
-  // private namespace by the launch file; every key not given keeps its default.
+  // The configuration file, loaded into the private namespace by the launch file, and the node's
+  // own parameters share that namespace: both tables are read from it in one pass. Keys not
+  // given keep their defaults; a bad value is fatal, naming the parameter.
   try {
-    const std::string yaml = estimatorYamlFromParameters(private_nh_);
-    return parseConfigText(yaml, "parameters of " + private_nh_.getNamespace());
+    ParameterTable table = estimatorParameters(estimator_config_);
+    const ParameterTable node = nodeParameters(parameters_);
+    table.insert(table.end(), node.begin(), node.end());
+    const std::vector<std::string> others = readParameterServer(private_nh_, table);
+    for (const std::string& other : others) {
+      ROS_WARN_STREAM(name_ << ": parameter " << private_nh_.resolveName(other)
+                            << " is neither the node's nor the estimator's: ignored (see doc/parameters.md)");
+    }
+    estimator_config_.validate();
+    parameters_.validate();
   } catch (const InputError& e) {
     const std::string message = name_ + ": " + e.what();
     ROS_FATAL_STREAM(message);
-    throw;
+    throw InputError(message);
   }
 }
 
@@ -263,7 +221,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     // A camera driver or bag publishes image and camera_info together, but the image callback
     // may run first: give the first camera_info a moment before calling it missing.
     std::unique_lock<std::mutex> lock(camera_mutex_);
-    if (!camera_info_ && !(parameters_.camera_fx > 0.0) && !(estimator_config_.fx > 0.0)) {
+    if (!camera_info_ && !(estimator_config_.camera_fx > 0.0)) {
       camera_ready_.wait_for(lock, std::chrono::seconds(1), [this] { return camera_info_ != nullptr; });
     }
     info = camera_info_;
@@ -272,6 +230,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
   // The camera of the frames as registered (set up as oefmt_offline does): camera_info's
   // calibration, or ~camera_fx, mapped to the image size, its lens distortion undone.
   std::optional<CameraParameters> calibration;
+  std::string source = "camera_info";
   if (info && info->K[0] > 0.0 && info->K[4] > 0.0) {
     try {
       calibration = cameraFromInfo(*info);
@@ -279,17 +238,18 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
       throw InputError(std::string("camera_info: ") + e.what());
     }
     if (!parameters_.undistort) calibration->distortion = Distortion{};
-  } else if (parameters_.camera_fx > 0.0) {
-    calibration = pinholeCamera(parameters_.camera_fx, image.size());
+  } else if (estimator_config_.camera_fx > 0.0) {
+    calibration = pinholeCamera(estimator_config_.camera_fx, image.size());
+    source = "~camera_fx";
   }
   if (calibration) {
-    updateUndistorter(*calibration, info ? "camera_info" : "~camera_fx", image.size());
+    updateUndistorter(*calibration, source, image.size());
   } else {
     undistorter_.reset();
   }
-  // Working-image focal length: the core crops to a square and resizes to N. Without camera
-  // intrinsics, the YAML's own (working-image) fx is the last resort.
-  const double working_fx = undistorter_ ? undistorter_->workingFx() : estimator_config_.fx;
+  // The working image's focal length (the core crops to a square and resizes to N): the
+  // undistortion set-up scales the camera to it.
+  const double working_fx = undistorter_ ? undistorter_->workingFx() : 0.0;
   if (!(working_fx > 0.0)) {
     ROS_ERROR_STREAM_THROTTLE(kWarnPeriod, name_ << ": no intrinsics: publish "
                                                  << nh_.resolveName("camera_info")
@@ -303,16 +263,16 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
   }
   if (!estimator_) {
     EstimatorConfig config = estimator_config_;
-    config.fx = working_fx;
+    config.working_fx = working_fx;
+    // The initial altitude: the altitude topic when asked for, else ~initial_altitude (the
+    // configuration file's, or the launch argument's).
     if (parameters_.use_altitude_topic) {
       if (!altitude_topic) {
         ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": waiting for a valid "
                                                     << nh_.resolveName("altitude") << " range");
         return false;
       }
-      config.altitude = *altitude_topic;
-    } else if (parameters_.initial_altitude > 0.0) {
-      config.altitude = parameters_.initial_altitude;
+      config.initial_altitude = *altitude_topic;
     }
     estimator_ = std::make_unique<Estimator>(config);
     lookUpCameraMount(frame);
@@ -320,7 +280,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     input_size_ = image.size();
     ROS_INFO_STREAM(name_ << ": odometry started at " << frame.stamp << " (" << image.cols << "x"
                           << image.rows << ", working fx " << working_fx << " px, scale "
-                          << (config.altitude > 0.0 ? "metric" : "initial altitude = 1") << ")");
+                          << (config.initial_altitude > 0.0 ? "metric" : "initial altitude = 1") << ")");
     const std::string upscaling = upscalingWarning(image.size(), config.registration.size);
     if (!upscaling.empty()) ROS_WARN_STREAM(name_ << ": " << upscaling);
   }

@@ -21,6 +21,7 @@
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "oefmt/io/config_file.h"
 #include "oefmt/registration/image_prep.h"
 #include "progress.h"
 #include "oefmt/registration/spectra.h"
@@ -66,16 +67,19 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
       ->required();
   app.add_option("--diagnostics", o.diagnostics, "one CSV line per frame: registration, matching, optimizer, timing")
       ->type_name("FILE");
-  app.add_option("--config", o.config, "parameters (config/default.yaml documents every key)")->type_name("FILE");
+  app.add_option("--config", o.config, "parameters (doc/parameters.md describes every key)")->type_name("FILE");
   app.add_option_function<std::string>(
          "--mode",
          [&o](const std::string& mode) { o.mode = oefmt::parseEnum(oefmt::kEstimatorModeNames, mode, "mode"); },
          "overrides the config's mode")
       ->type_name(oefmt::tools::shownWords(oefmt::kEstimatorModeNames));
   oefmt::tools::addNumber(app, "--altitude", o.altitude, "M",
-                          "altitude above the dominant plane at the first frame [m]: metric\n"
-                          "output (otherwise units of the initial altitude)");
-  oefmt::tools::addNumber(app, "--fx", o.fx, "PX", "focal length of the images [px] (overrides cam_param/CameraInfo)");
+                          "overrides the config's initial_altitude: the altitude above the\n"
+                          "dominant plane at the first frame [m], for metric output\n"
+                          "(otherwise units of the initial altitude)");
+  oefmt::tools::addNumber(app, "--fx", o.fx, "PX",
+                          "focal length of the images [px]: replaces the calibration's\n"
+                          "(cam_param.yaml/CameraInfo, else the config's camera_fx)");
   app.add_flag_callback("--no-undistort", [&o] { o.undistort = false; },
                         "take the images as undistorted: ignore the lens distortion of\n"
                         "cam_param.yaml/CameraInfo (rectified images, or renders whose\n"
@@ -141,7 +145,7 @@ int main(int argc, char** argv) {
     oefmt::EstimatorConfig config =
         options.config.empty() ? oefmt::EstimatorConfig{} : oefmt::loadConfig(options.config);
     if (options.mode) config.mode = *options.mode;
-    if (options.altitude > 0.0) config.altitude = options.altitude;
+    if (options.altitude > 0.0) config.initial_altitude = options.altitude;
     config.validate();
 
     std::unique_ptr<oefmt::FrameSource> opened =
@@ -175,12 +179,15 @@ int main(int argc, char** argv) {
         }
         calibration = camera;
         source = "--fx";
+      } else if (!calibration && config.camera_fx > 0.0) {
+        calibration = oefmt::pinholeCamera(config.camera_fx, image_size);
+        source = "camera_fx";
       }
       if (calibration) {
         if (!options.undistort) calibration->distortion = oefmt::Distortion{};
         undistorter = std::make_shared<const oefmt::Undistorter>(*calibration, image_size,
                                                                  config.registration.size, source);
-        config.fx = undistorter->workingFx();
+        config.working_fx = undistorter->workingFx();
       }
     }
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
@@ -201,7 +208,7 @@ int main(int argc, char** argv) {
     trajectory.open(options.output);
     if (!trajectory) throw oefmt::InputError("cannot write '" + options.output + "'");
     trajectory << "# oefmt_offline " << oefmt::toString(config.mode) << ": t x y z qx qy qz qw ("
-               << (config.altitude > 0.0 ? "metres" : "units of the initial altitude") << ")\n";
+               << (config.initial_altitude > 0.0 ? "metres" : "units of the initial altitude") << ")\n";
     if (!options.diagnostics.empty()) {
       diagnostics.open(options.diagnostics);
       if (!diagnostics) throw oefmt::InputError("cannot write '" + options.diagnostics + "'");
@@ -224,7 +231,7 @@ int main(int argc, char** argv) {
       if (!estimator) {
         if (!undistorter && !options.quiet) {
           std::fprintf(stderr, "oefmt_offline: no intrinsics (no cam_param.yaml/CameraInfo, no "
-                               "--fx): assuming a 53 degree field of view\n");
+                               "--fx, no camera_fx): assuming a 53 degree field of view\n");
         }
         estimator = std::make_unique<oefmt::Estimator>(config, context);
         const std::string upscaling = oefmt::upscalingWarning(frame.image_size, config.registration.size);

@@ -39,8 +39,8 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   EstimatorConfig config;
   config.mode = mode;
   config.registration.fft_planning = FftPlanning::kEstimate;
-  config.altitude = plan.track.altitude;
-  config.fx = plan.camera.intrinsics.fx;
+  config.initial_altitude = plan.track.altitude;
+  config.working_fx = plan.camera.intrinsics.fx;
   Estimator estimator(config);
   StampedTrajectory estimate, truth;
   FlightRun run;

@@ -56,8 +56,8 @@ double wrapDegrees(double radians) { return std::remainder(radians, 2.0 * M_PI) 
 FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames, const Undistorter& camera) {
   EstimatorConfig config;
   config.registration.fft_planning = FftPlanning::kEstimate;
-  config.altitude = plan.track.altitude;
-  config.fx = camera.workingFx();
+  config.initial_altitude = plan.track.altitude;
+  config.working_fx = camera.workingFx();
   Estimator estimator(config);
   StampedTrajectory estimate, truth;
   FlightRun run;

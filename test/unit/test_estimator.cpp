@@ -24,8 +24,8 @@ EstimatorConfig flightConfig(EstimatorMode mode = EstimatorMode::kOefmt) {
   config.mode = mode;
   config.registration.size = kN;
   config.registration.fft_planning = FftPlanning::kEstimate;
-  config.altitude = kN;
-  config.fx = kN;
+  config.initial_altitude = kN;
+  config.working_fx = kN;
   return config;
 }
 
@@ -300,7 +300,7 @@ TEST(Estimator, FramesAnalysedAheadGiveTheSamePoses) {
 
 TEST(Estimator, InvalidConfigurationIsRejected) {
   EstimatorConfig config = flightConfig();
-  config.altitude = -1.0;
+  config.initial_altitude = -1.0;
   EXPECT_THROW(Estimator{config}, InputError);
   config = flightConfig();
   config.registration.size = 100 + 1;

@@ -1,17 +1,18 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// EstimatorConfig: YAML loading, validation and config/default.yaml.
+// EstimatorConfig: its parameter table, validation and config/default.yaml.
 #include <gtest/gtest.h>
 
-#include <cstdio>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <sstream>
+#include <limits>
+#include <set>
 #include <string>
 
+#include "oefmt/io/config_file.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator_config.h"
-#include "oefmt/io/yaml_text.h"
 
 namespace oefmt {
 namespace {
@@ -21,180 +22,143 @@ namespace fs = std::filesystem;
 // The package root, from this file's path (test/unit/...).
 fs::path packageRoot() { return fs::path(__FILE__).parent_path().parent_path().parent_path(); }
 
-// Writes `text` to a fresh temporary YAML file and returns its path.
-std::string writeYaml(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / ("oefmt_test_" + name + ".yaml");
-  std::ofstream(path) << text;
-  return path.string();
+std::string readFile(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
 }
 
-std::string errorOf(const std::string& yaml) {
-  try {
-    loadConfig(writeYaml("error", yaml));
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+TEST(EstimatorConfig, DefaultYamlIsTheGeneratedOne) {
+  const fs::path path = packageRoot() / "config" / "default.yaml";
+  EXPECT_EQ(readFile(path), configToYaml(EstimatorConfig{}, true))
+      << "config/default.yaml is not what the parameter table gives: regenerate it with\n"
+         "  rosrun oefmt oefmt_parameters --yaml > config/default.yaml";
+  EXPECT_EQ(configToYaml(loadConfig(path.string())), configToYaml(EstimatorConfig{}));
 }
 
-TEST(EstimatorConfig, DefaultYamlHoldsEveryDefault) {
-  const EstimatorConfig loaded = loadConfig((packageRoot() / "config" / "default.yaml").string());
-  EXPECT_EQ(configToYaml(loaded), configToYaml(EstimatorConfig{}));
-}
-
-TEST(EstimatorConfig, DefaultYamlDocumentsEveryKey) {
-  std::ifstream file(packageRoot() / "config" / "default.yaml");
-  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  std::istringstream keys(configToYaml(EstimatorConfig{}));
-  std::string line;
-  while (std::getline(keys, line)) {
-    const auto colon = line.find(':');
-    if (line.empty() || line[0] == '%' || line[0] == '-' || colon == std::string::npos) continue;
-    // Each key's line is preceded by its comment line.
-    const std::string key_line = line.substr(0, colon + 1);
-    const auto at = text.find("\n" + key_line);
-    ASSERT_NE(at, std::string::npos) << key_line;
-    const auto previous_line_start = text.rfind('\n', at - 1);
-    EXPECT_NE(text.substr(previous_line_start + 1, at - previous_line_start).find('#'), std::string::npos)
-        << "no comment above " << key_line;
-  }
-}
-
-TEST(EstimatorConfig, RoundTripThroughYaml) {
+TEST(EstimatorConfig, EveryParameterIsDescribedOnce) {
   EstimatorConfig config;
-  config.mode = EstimatorMode::kEfmt;
-  config.altitude = 62.8;
-  config.fx = 373.5;
-  config.registration.size = 256;
-  config.registration.resolve_half_turn = false;
-  config.registration.fft_planning = FftPlanning::kEstimate;
-  config.matching.shift_step = 0.02;
-  config.optimizer.robust_loss = RobustLoss::kHuber;
-  config.optimizer.function_tolerance = 1e-7;
-  config.tracking.predict_failed_frames = false;
-  config.efmt.zoom_samples = 3;
-  const EstimatorConfig loaded = loadConfig(writeYaml("roundtrip", configToYaml(config)));
-  EXPECT_EQ(configToYaml(loaded), configToYaml(config));
-  EXPECT_EQ(loaded.mode, EstimatorMode::kEfmt);
-  EXPECT_DOUBLE_EQ(loaded.optimizer.function_tolerance, 1e-7);
-}
-
-TEST(EstimatorConfig, MissingKeysKeepTheirDefaults) {
-  const EstimatorConfig c =
-      loadConfig(writeYaml("partial", "%YAML:1.0\nmode: fmt\nregistration:\n  size: 256\n"));
-  EXPECT_EQ(c.mode, EstimatorMode::kFmt);
-  EXPECT_EQ(c.registration.size, 256);
-  EXPECT_DOUBLE_EQ(c.registration.taper_fraction, 0.12);
-  EXPECT_EQ(c.tracking.max_failed_frames, 3);
-}
-
-TEST(EstimatorConfig, AcceptsCommonSpellings) {
-  const EstimatorConfig c = loadConfig(writeYaml(
-      "spellings", "%YAML:1.0\noptimizer:\n  function_tolerance: 1e-7\n"
-                   "tracking:\n  predict_failed_frames: false\nregistration:\n  resolve_half_turn: 0\n"));
-  EXPECT_DOUBLE_EQ(c.optimizer.function_tolerance, 1e-7);
-  EXPECT_FALSE(c.tracking.predict_failed_frames);
-  EXPECT_FALSE(c.registration.resolve_half_turn);
-}
-
-TEST(EstimatorConfig, EveryFftPlanningEffortRoundTrips) {
-  for (const FftPlanning planning : {FftPlanning::kEstimate, FftPlanning::kMeasure, FftPlanning::kPatient}) {
-    EstimatorConfig config;
-    config.registration.fft_planning = planning;
-    const EstimatorConfig loaded = loadConfig(writeYaml("planning", configToYaml(config)));
-    EXPECT_EQ(loaded.registration.fft_planning, planning) << toString(planning);
+  const ParameterTable table = estimatorParameters(config);
+  std::set<std::string> keys;
+  std::set<std::string> sections;
+  for (const ParameterSection& s : estimatorParameterSections()) sections.insert(s.name);
+  for (const Parameter& p : table) {
+    EXPECT_TRUE(keys.insert(p.key).second) << p.key << " twice";
+    EXPECT_FALSE(p.meaning.empty()) << p.key;
+    EXPECT_EQ(p.meaning.find('\n'), std::string::npos) << p.key << ": one line";
+    EXPECT_EQ(sections.count(p.section()), 1u) << p.key << ": a section without a heading";
+    if (p.type == ParameterType::kNumber || p.type == ParameterType::kInteger) {
+      EXPECT_FALSE(p.rule().empty()) << p.key << ": no accepted range";
+    }
+    EXPECT_TRUE(p.problem().empty()) << p.key << ": the default is refused: " << p.problem();
   }
-  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  fft_planning: exhaustive\n").find("estimate, measure or patient"),
-            std::string::npos);
+  // The fields bound are the config's own: setting through the table changes the config.
+  findParameter(table, "registration.size")->setNumber(256);
+  findParameter(table, "optimizer.robust_loss")->setWord("huber");
+  EXPECT_EQ(config.registration.size, 256);
+  EXPECT_EQ(config.optimizer.robust_loss, RobustLoss::kHuber);
+  EXPECT_EQ(findParameter(table, "working_fx"), nullptr) << "set from the camera, not a parameter";
 }
 
-TEST(EstimatorConfig, ErrorsNameTheKey) {
-  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  sise: 512\n").find("registration.sise"),
-            std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\nmode: slam\n").find("'mode'"), std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  size: 300.5\n").find("registration.size"),
-            std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  size: 3\n").find("'size'"), std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\naltitude: -5.0\n").find("'altitude'"), std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\noptimizer:\n  robust_loss: tukey\n").find("optimizer.robust_loss"),
-            std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\ntracking:\n  predict_failed_frames: maybe\n")
-                .find("tracking.predict_failed_frames"),
-            std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\nlocal_optimizer:\n  max_iterations: 5\n").find("local_optimizer"),
-            std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\nmatching:\n  shift_step: abc\n").find("matching.shift_step"),
-            std::string::npos);
-  // The parameters added for dense multi-depth scenes: out-of-range values are refused by name.
-  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  rotation_zoom_candidates: 0\n").find("'rotation_zoom_candidates'"),
-            std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\ntracking:\n  steady_layer_min_fraction: 1.5\n").find("'steady_layer_min_fraction'"),
-            std::string::npos);
-  // A number with a unit after it, and one beyond float range (strtod: ERANGE).
-  EXPECT_NE(errorOf("%YAML:1.0\naltitude: 12m\n").find("'altitude'"), std::string::npos);
-  EXPECT_NE(errorOf("%YAML:1.0\nregistration:\n  min_texture: 1e-400\n").find("registration.min_texture"),
-            std::string::npos);
-}
-
-TEST(EstimatorConfig, UnreadableFilesAreInputErrors) {
-  EXPECT_THROW(loadConfig("/nonexistent/oefmt.yaml"), InputError);
-  EXPECT_THROW(loadConfig(writeYaml("garbage", "this is: [not closed\n")), InputError);
-}
-
-TEST(EstimatorConfig, ScaleHelpers) {
-  EstimatorConfig c;
-  EXPECT_DOUBLE_EQ(c.effectiveFx(), 512.0);
-  EXPECT_DOUBLE_EQ(c.initialAltitude(), 1.0);
-  c.fx = 400.0;
-  c.altitude = 50.0;
-  EXPECT_DOUBLE_EQ(c.effectiveFx(), 400.0);
-  EXPECT_DOUBLE_EQ(c.initialAltitude(), 50.0);
-  EXPECT_EQ(parseEnum(kEstimatorModeNames, "efmt", "mode"), EstimatorMode::kEfmt);
-  EXPECT_STREQ(toString(EstimatorMode::kOefmt), "oefmt");
-  EXPECT_THROW(parseEnum(kEstimatorModeNames, "OEFMT", "mode"), InputError);
-}
-
-}  // namespace
-}  // namespace oefmt
-
-namespace oefmt {
-namespace {
-
-// What OpenCV's YAML reader would hang or overflow its stack on is refused before parsing.
-TEST(YamlText, DeepNestingHugeFilesAndNulBytesAreRefused) {
-  EXPECT_NO_THROW(checkYamlText("%YAML:1.0\nmode: oefmt\nregistration:\n  size: 512\n", "f"));
-  EXPECT_NO_THROW(checkYamlText("a: [1, [2, 3], {b: 4}]  # [[[[ in a comment\nc: \"[[[[\"\n", "f"));
-  const auto message = [](const std::string& text) {
+// The accepted values the table documents are the ones enforced, also by the registration's and
+// the optimizer's own checks (their libraries run those without the table): at each finite bound
+// the value is accepted unless the bound is open, and the nearest value beyond it is refused.
+TEST(EstimatorConfig, DocumentedRangesAreTheEnforcedOnes) {
+  int bounds_checked = 0;
+  const auto accepted = [](const EstimatorConfig& c, const std::string& section) {
     try {
-      checkYamlText(text, "file 'x.yaml'");
+      c.validate();
+      if (section == "registration") c.registration.validate();
+      if (section == "optimizer") c.optimizer.validate();
+      if (section == "matching") c.matching.validate();
+      if (section == "tracking") c.tracking.validate();
+      if (section == "uncertainty") c.uncertainty.validate();
+      if (section == "efmt") c.efmt.validate();
+    } catch (const InputError&) {
+      return false;
+    }
+    return true;
+  };
+  EstimatorConfig reference;
+  const std::size_t rows = estimatorParameters(reference).size();
+  for (std::size_t row = 0; row < rows; ++row) {
+    for (const bool upper : {false, true}) {
+      EstimatorConfig c;
+      const Parameter p = estimatorParameters(c)[row];
+      if (p.type != ParameterType::kNumber && p.type != ParameterType::kInteger) continue;
+      const double bound = upper ? p.range.max : p.range.min;
+      if (!std::isfinite(bound)) continue;
+      const bool open = upper ? p.range.max_open : p.range.min_open;
+      const double outward = upper ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
+      const auto set = [&](double value) {
+        if (p.type == ParameterType::kNumber) *p.number = value;
+        else *p.integer = static_cast<int>(value);
+      };
+      const bool integer = p.type == ParameterType::kInteger;
+      set(bound);
+      EXPECT_EQ(accepted(c, p.section()), !open) << p.key << " = " << bound;
+      set(integer ? bound + (upper ? -(p.range.even ? 2 : 1) : (p.range.even ? 2 : 1))
+                  : std::nextafter(bound, -outward));
+      EXPECT_TRUE(accepted(c, p.section())) << p.key << " just inside " << bound;
+      set(integer ? bound + (upper ? 1 : -1) : std::nextafter(bound, outward));
+      EXPECT_FALSE(accepted(c, p.section())) << p.key << " just beyond " << bound;
+      ++bounds_checked;
+    }
+  }
+  EXPECT_GT(bounds_checked, 60);
+  EstimatorConfig odd;
+  odd.registration.size = 66 + 1;
+  EXPECT_THROW(odd.registration.validate(), InputError);
+  EXPECT_THROW(odd.validate(), InputError);
+}
+
+TEST(EstimatorConfig, ValidationNamesTheParameter) {
+  const auto message = [](const EstimatorConfig& c) {
+    try {
+      c.validate();
     } catch (const InputError& e) {
       return std::string(e.what());
     }
     return std::string("accepted");
   };
-  EXPECT_NE(message("a: " + std::string(100000, '[')).find("nests"), std::string::npos);
-  EXPECT_NE(message("a: " + std::string(100, '{')).find("line 1"), std::string::npos);
-  std::string indented = "a:\n";
-  for (int level = 1; level <= 70; ++level) indented += std::string(level, ' ') + "k:\n";
-  EXPECT_NE(message(indented).find("nests"), std::string::npos);
-  std::string dashes;
-  for (int i = 0; i < 40; ++i) dashes += "- ";
-  EXPECT_NE(message(dashes + "x\n").find("nests"), std::string::npos);
-  EXPECT_NE(message(std::string("a: 1\n") + '\0').find("NUL"), std::string::npos);
-  EXPECT_NE(message(std::string(kMaxYamlBytes + 1, '#')).find("bytes"), std::string::npos);
-  EXPECT_NE(message("a: [").find("accepted"), std::string::npos) << "OpenCV's to refuse";
+  EstimatorConfig c;
+  c.efmt.zoom_samples = 0;
+  EXPECT_EQ(message(c), "invalid parameter 'efmt.zoom_samples': must be in [1, 50], got 0");
+  c = EstimatorConfig{};
+  c.tracking.assumed_altitude = std::nan("");
+  EXPECT_NE(message(c).find("'tracking.assumed_altitude'"), std::string::npos);
+  c = EstimatorConfig{};
+  c.working_fx = -1.0;
+  EXPECT_NE(message(c).find("focal length"), std::string::npos);
+  EXPECT_NO_THROW(MatchingConfig{}.validate());
 }
 
-TEST(YamlText, LoadConfigRefusesADeeplyNestedFileWithoutParsingIt) {
-  const std::string path = ::testing::TempDir() + "/oefmt_deep.yaml";
-  std::ofstream(path) << "%YAML:1.0\nmode: " << std::string(200000, '[') << "\n";
+TEST(EstimatorConfig, ScaleHelpers) {
+  EstimatorConfig c;
+  EXPECT_DOUBLE_EQ(c.effectiveFx(), 512.0);
+  EXPECT_DOUBLE_EQ(c.initialAltitudeOrOne(), 1.0);
+  c.working_fx = 400.0;
+  c.camera_fx = 3000.0;  // the input images': not the estimator's
+  c.initial_altitude = 50.0;
+  EXPECT_DOUBLE_EQ(c.effectiveFx(), 400.0);
+  EXPECT_DOUBLE_EQ(c.initialAltitudeOrOne(), 50.0);
+}
+
+TEST(EnumNames, OneTablePerEnum) {
+  EXPECT_STREQ(toString(EstimatorMode::kOefmt), "oefmt");
+  EXPECT_EQ(parseEnum(kEstimatorModeNames, "efmt", "mode"), EstimatorMode::kEfmt);
   try {
-    loadConfig(path);
-    FAIL() << "a 200000-deep file was parsed";
+    parseEnum(kEstimatorModeNames, "OEFMT", "mode");
+    FAIL() << "case matters";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("oefmt_deep.yaml"), std::string::npos) << e.what();
+    EXPECT_STREQ(e.what(), "unknown mode 'OEFMT': expected oefmt, efmt or fmt");
   }
-  std::remove(path.c_str());
+  for (const FftPlanning planning : {FftPlanning::kEstimate, FftPlanning::kMeasure, FftPlanning::kPatient}) {
+    EXPECT_EQ(parseEnum(kFftPlanningNames, toString(planning), "planning"), planning);
+  }
+  EXPECT_STREQ(toString(RobustLoss::kCauchy), "cauchy");
+  EXPECT_STREQ(toString(static_cast<RobustLoss>(17)), "unknown");
+  EXPECT_EQ(wordList({"a"}), "a");
+  EXPECT_EQ(wordList({"a", "b"}), "a or b");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "oefmt/io/dataset.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "oefmt/io/config_file.h"
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/registration/registration.h"
 #include "support/fixtures.h"

@@ -1,18 +1,20 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Parameters of the estimator, loaded from one YAML file (config/default.yaml documents every
-// key) by the offline tools and, as private parameters, by the ROS node.
+// Parameters of the estimator and the table that describes each of them once (key, type, unit,
+// accepted values, meaning): the configuration file's reader (config_file.h), the ROS node and
+// the generated doc/parameters.md read that table. No file I/O here.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "oefmt/enum_names.h"
-#include "oefmt/registration/registration_config.h"
 #include "oefmt/estimation/local_optimizer.h"
-#include "oefmt/io/yaml_map.h"
+#include "oefmt/estimation/parameter_table.h"
+#include "oefmt/registration/registration_config.h"
 
 namespace oefmt {
 
-/// Which method turns frames into motion (doc/method.md, Comparison modes).
+/// Which method turns frames into motion (the paper's comparison).
 enum class EstimatorMode {
   kOefmt,  ///< o-eFMT: energy vectors, three-frame window, pattern matching, local optimizer
   kEfmt,   ///< original eFMT: multi-zoom translation profiles, consecutive pairs, PMT scale chain
@@ -22,7 +24,7 @@ inline constexpr EnumName<EstimatorMode> kEstimatorModeNames[] = {
     {EstimatorMode::kOefmt, "oefmt"}, {EstimatorMode::kEfmt, "efmt"}, {EstimatorMode::kFmt, "fmt"}};
 inline const char* toString(EstimatorMode mode) { return enumName(kEstimatorModeNames, mode); }
 
-/// Pattern matching of energy vectors (doc/method.md, Pattern matching).
+/// Pattern matching of energy vectors.
 struct MatchingConfig {
   int stretch_steps = 100;            ///< PMT candidates exp(m key / 1000), m = -steps..steps
   double stretch_key_12 = 16.0;       ///< candidate spacing of PMT 0-1 vs 1-2 [per mille of ln]
@@ -91,7 +93,7 @@ struct UncertaintyConfig {
   void validate() const;
 };
 
-/// The original eFMT's multi-zoom translation (doc/method.md, Comparison modes).
+/// The original eFMT's multi-zoom translation.
 struct EfmtConfig {
   int zoom_samples = 5;          ///< zooms sampled between the least and most significant
   double zoom_threshold = 0.2;   ///< significant: zoom energy above this fraction of its peak
@@ -105,10 +107,15 @@ struct EstimatorConfig {
   EstimatorMode mode = EstimatorMode::kOefmt;
   /// Altitude of the first frame above the dominant plane [m]; 0 = unknown (poses in units of
   /// the initial altitude).
-  double altitude = 0.0;
-  /// Focal length in pixels of the working image (registration.size); 0 = assume size (a 53 deg
-  /// field of view). Scale the camera's fx by size / min(width, height) (scaleIntrinsics).
-  double fx = 0.0;
+  double initial_altitude = 0.0;
+  /// Focal length of the input images [px of those images] for frames that come without a
+  /// calibration (cam_param.yaml, CameraInfo); 0 = unknown. The estimator does not read it: the
+  /// programs make a pinhole camera of it, whose Undistorter gives working_fx.
+  double camera_fx = 0.0;
+  /// Focal length of the working image (registration.size) [px]: set by the program from the
+  /// camera of the frames (Undistorter::workingFx), not a parameter of the file. 0 = unknown: a
+  /// 53 deg field of view (fx = size) is assumed.
+  double working_fx = 0.0;
   /// Run the two registrations of a frame (1-2 and 0-2) on two threads (the second core).
   bool parallel_registrations = true;
   RegistrationConfig registration;
@@ -118,21 +125,27 @@ struct EstimatorConfig {
   UncertaintyConfig uncertainty;
   EfmtConfig efmt;
 
-  /// fx, or the working size when fx is 0.
-  double effectiveFx() const { return fx > 0.0 ? fx : registration.size; }
-  /// Z_0 in output units: the altitude, or 1 when unknown.
-  double initialAltitude() const { return altitude > 0.0 ? altitude : 1.0; }
+  /// working_fx, or the working size when it is 0.
+  double effectiveFx() const { return working_fx > 0.0 ? working_fx : registration.size; }
+  /// Z_0 in output units: initial_altitude, or 1 when unknown.
+  double initialAltitudeOrOne() const { return initial_altitude > 0.0 ? initial_altitude : 1.0; }
   /// Throws InputError naming the first invalid field.
   void validate() const;
 };
 
-/// Reads a YAML file of parameters (parseYaml: maps of scalars; a leading "%YAML" directive
-/// and "---" are optional). Missing keys keep their defaults; unknown keys and bad values throw
-/// InputError naming the key (e.g. "registration.size") and the rule. The result is validated.
-EstimatorConfig loadConfig(const std::string& yaml_path);
-/// The same from parsed YAML; `source` names it in error messages.
-EstimatorConfig parseConfig(const YamlNode& root, const std::string& source);
-/// Every parameter as YAML text that loadConfig reads back (for logging the effective values).
-std::string configToYaml(const EstimatorConfig& config);
+/// Every parameter of the configuration file (config/default.yaml, oefmt_offline --config, the
+/// node's private parameters), bound to `config`'s fields, in the file's order. Made for a
+/// default EstimatorConfig, its values are the defaults.
+ParameterTable estimatorParameters(EstimatorConfig& config);
+
+/// A section of the table ("" = the top-level keys) and its heading, in the file's order.
+struct ParameterSection {
+  const char* name;
+  const char* title;
+};
+const std::vector<ParameterSection>& estimatorParameterSections();
+
+/// For a key the configuration no longer has: what replaced it ("" for any other key).
+std::string retiredParameterHint(const std::string& key);
 
 }  // namespace oefmt

@@ -49,11 +49,12 @@ struct CameraParameters {
   Distortion distortion;
 };
 
-/// Reads the authors' cam_param.yaml (parseYaml; "%YAML:1.0" header optional) with Camera.fx, fy,
+/// Reads the authors' cam_param.yaml (yaml-cpp; "%YAML:1.0" header optional) with Camera.fx, fy,
 /// cx, cy (required) and Camera.k1, k2, p1, p2, k3, k4, k5, k6, width, height (optional; missing
 /// distortion is 0, missing size is 0). Camera.type, when given, must be "PinHole" (the model
-/// above; ORB-SLAM's "KannalaBrandt8" fisheye is refused). Throws DatasetError naming the file and
-/// the missing or invalid key.
+/// above; ORB-SLAM's "KannalaBrandt8" fisheye is refused). Other keys are ignored. Throws
+/// DatasetError naming the file, the line and the key for a missing or invalid key, a key given
+/// twice and a file that is not one YAML map.
 CameraParameters readCameraParameters(const std::string& path);
 
 /// Writes `camera` in the same layout (the ten Camera.* keys of the authors' file, plus k3..k6 when

@@ -22,7 +22,7 @@ namespace oefmt {
 std::string describeSizeMapping(const Intrinsics& calibration, cv::Size image_size,
                                 const std::string& source);
 
-/// What a bare focal length (oefmt_offline --fx, the node's ~camera_fx) stands for: a pinhole
+/// What a bare focal length (oefmt_offline --fx, the parameter camera_fx) stands for: a pinhole
 /// with fx = fy = `fx` for images of `image_size`, the principal point at their centre.
 CameraParameters pinholeCamera(double fx, cv::Size image_size);
 

@@ -32,35 +32,11 @@
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/estimation/estimator_config.h"
 #include "oefmt/ros/frame_queue.h"
+#include "oefmt/ros/node_parameters.h"
 #include "oefmt/ros/stamp_guard.h"
 #include "oefmt/io/undistortion.h"
 
 namespace oefmt {
-
-/// Parameters that only the ROS wrapper has (the estimator's come from the same YAML file as
-/// oefmt_offline's, see config/default.yaml).
-struct RosParameters {
-  std::string odom_frame = "odom";
-  std::string base_frame = "base_link";
-  std::string camera_frame;          ///< empty: the image header's frame_id
-  bool publish_tf = true;
-  bool compressed = false;           ///< subscribe to image/compressed instead of image
-  int queue_size = 2;                ///< subscriber queue of image, camera_info
-  int input_buffer = 1;              ///< frames waiting for the worker (1: the newest wins)
-  int path_length = 2000;            ///< poses kept in the published path (0 = no path)
-  /// Focal length [px] of the camera images, used when no camera_info arrives. (Not the YAML's
-  /// `fx`, which is the working image's and is set from this or from camera_info.)
-  double camera_fx = 0.0;
-  /// Undo the lens distortion camera_info gives (false: the images are already rectified, or
-  /// camera_info's D belongs to another lens than the one that took them).
-  bool undistort = true;
-  double initial_altitude = 0.0;     ///< altitude above the dominant plane at start [m], 0 = unknown
-  bool use_altitude_topic = false;   ///< take the initial altitude from the `altitude` Range topic
-  double time_jump_tolerance = 1.0;  ///< a stamp this far back [s] resets (bag loop)
-  double diagnostics_period = 1.0;   ///< [s]
-  double min_rate = 1.0;             ///< expected input/output rate window [Hz] for diagnostics
-  double max_rate = 100.0;
-};
 
 class OdometryRos {
  public:
@@ -81,8 +57,8 @@ class OdometryRos {
     ros::WallTime received;
   };
 
+  /// Reads and validates the estimator's and the node's parameters (fatal: InputError).
   void loadParameters();
-  EstimatorConfig loadEstimatorConfig();
   void imageCallback(const sensor_msgs::ImageConstPtr& message);
   void compressedCallback(const sensor_msgs::CompressedImageConstPtr& message);
   void cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& message);
