@@ -5,8 +5,9 @@
 catkin_add_gtest(oefmt_tool_tests test/tools/test_bag_io.cpp test/tools/test_tools.cpp
                  test/tools/test_debug_rendering.cpp test/tools/test_frame_source.cpp
                  test/tools/test_stamp_guard.cpp test/tools/test_frame_queue.cpp
-                 test/tools/test_rectification.cpp
-                 src/tools/frame_source.cpp src/tools/bag_source.cpp test/support/gtest_main.cpp)
+                 test/tools/test_rectification.cpp test/tools/test_parameter_doc.cpp
+                 src/tools/frame_source.cpp src/tools/bag_source.cpp src/tools/parameter_doc.cpp
+                 test/support/gtest_main.cpp)
 if(TARGET oefmt_tool_tests)
   target_include_directories(oefmt_tool_tests PRIVATE test src/tools)
   target_link_libraries(oefmt_tool_tests oefmt_ros oefmt_bag_io oefmt_sim oefmt_evaluation opencv_imgcodecs)

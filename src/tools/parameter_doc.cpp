@@ -86,10 +86,10 @@ std::string parametersMarkdown() {
   }
   out << "\n## ROS node parameters\n"
          "\n"
-         "The node's own parameters, in its private namespace beside the configuration file's (the\n"
-         "launch arguments of `launch/oefmt.launch` of the same names set them). The topics are\n"
-         "`image` (or `image/compressed`), `camera_info` and `altitude` in, `odom`, `path`,\n"
-         "`energy_vectors` and `debug/*` out.\n\n";
+         "The node's own parameters, in its private namespace beside the configuration file's\n"
+         "(`~initial_altitude`, `~registration/size`, ...). `launch/oefmt.launch` sets several of\n"
+         "them from its arguments of the same names. A private parameter that neither table has is\n"
+         "reported and ignored; a bad value of either stops the node, naming the parameter.\n\n";
   writeRows(out, node, "", "~");
   return out.str();
 }
