@@ -5,7 +5,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <set>
-#include <vector>
+#include <sstream>
 
 #include "oefmt/error.h"
 
@@ -90,20 +90,85 @@ void requireUniqueKeys(const YAML::Node& map, const std::string& what) {
   }
 }
 
+namespace {
+
+// What one document holds, from yaml-cpp's parser events: the count of nodes other than null
+// and where the first one is.
+class ContentCounter : public YAML::EventHandler {
+ public:
+  int content = 0;
+  YAML::Mark first = YAML::Mark::null_mark();
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { count(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string&) override {
+    count(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    count(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    count(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void count(const YAML::Mark& mark) {
+    if (content++ == 0) first = mark;
+  }
+};
+
+// True when some line holds more than blanks, a comment, a directive or a document marker.
+bool hasContent(const std::string& text) {
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const auto start = line.find_first_not_of(" \t\r");
+    if (start == std::string::npos || line[start] == '#' || (start == 0 && line[0] == '%')) continue;
+    const std::string body = line.substr(start, line.find_last_not_of(" \t\r") + 1 - start);
+    if (start == 0 && (body == "---" || body == "...")) continue;
+    return true;
+  }
+  return false;
+}
+
+std::string atLine(const std::string& what, const YAML::Mark& mark) {
+  return mark.is_null() ? what : what + ", line " + std::to_string(mark.line + 1);
+}
+
+}  // namespace
+
 YAML::Node parseYamlMap(const std::string& text, const std::string& what) {
   checkYamlText(text, what);
-  std::vector<YAML::Node> documents;
+  YAML::Node root;
   try {
-    documents = YAML::LoadAll(text);
+    // Documents are counted by the parser, three at most, and only the first is built (Load):
+    // on some malformed text (a stray ',') yaml-cpp 0.7's parser reports one more empty
+    // document for ever, so that LoadAll never returns.
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    for (int document = 0; document < 3; ++document) {
+      ContentCounter counter;
+      if (!parser.HandleNextDocument(counter)) break;
+      if (document > 0 && counter.content > 0) {
+        throw InputError(atLine(what, counter.first) + ": a second document: one map of parameters per file");
+      }
+      if (document == 2) throw InputError(what + ": not YAML the reader can end (a stray ',' or '&'?)");
+    }
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    const std::string where = e.mark.is_null() ? what : what + ", line " + std::to_string(e.mark.line + 1);
-    throw InputError(where + ": " + e.msg);
+    throw InputError(atLine(what, e.mark) + ": " + e.msg);
   }
-  if (documents.size() > 1) {
-    throw InputError(yamlWhere(what, documents[1]) + ": a second document: one map of parameters per file");
+  if (root.IsNull()) {
+    // An empty document (comments only) is an empty map; yaml-cpp also reads some malformed
+    // text (an anchor before an open quote) as null, which must not pass as "no parameters".
+    if (hasContent(text)) throw InputError(what + ": holds no map of 'key: value' lines that the YAML reader can read");
+    return YAML::Node(YAML::NodeType::Map);
   }
-  if (documents.empty() || documents[0].IsNull()) return YAML::Node(YAML::NodeType::Map);
-  const YAML::Node& root = documents[0];
   if (!root.IsMap()) throw InputError(yamlWhere(what, root) + ": expected a map of 'key: value' lines");
   requireUniqueKeys(root, what);
   return root;

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <string>
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 namespace oefmt {
