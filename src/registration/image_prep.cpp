@@ -159,21 +159,4 @@ PreparedImage prepareImage(const cv::Mat& image, int size, ChannelOrder order) {
   return prepared;
 }
 
-Intrinsics scaleIntrinsics(const Intrinsics& in, int size) {
-  if (!in.valid()) throw InputError("intrinsics are invalid (fx, fy, width and height must be > 0)");
-  const int side = std::min(in.width, in.height);
-  const double k = static_cast<double>(size) / side;
-  const double x0 = (in.width - side) / 2;
-  const double y0 = (in.height - side) / 2;
-  Intrinsics out;
-  out.fx = in.fx * k;
-  out.fy = in.fy * k;
-  // Pixel centres sit at integer coordinates: the resize maps u to (u + 0.5) * k - 0.5.
-  out.cx = (in.cx - x0 + 0.5) * k - 0.5;
-  out.cy = (in.cy - y0 + 0.5) * k - 0.5;
-  out.width = size;
-  out.height = size;
-  return out;
-}
-
 }  // namespace oefmt

@@ -60,7 +60,4 @@ std::string upscalingWarning(cv::Size image_size, int size);
 PreparedImage prepareImage(const cv::Mat& image, int size,
                            ChannelOrder order = ChannelOrder::kBgr);
 
-/// Intrinsics of the prepared size x size image made from an image of intrinsics.width x height.
-Intrinsics scaleIntrinsics(const Intrinsics& intrinsics, int size);
-
 }  // namespace oefmt
