@@ -23,6 +23,7 @@
 #include "oefmt/estimation/pose.h"
 #include "oefmt/io/undistortion.h"
 #include "oefmt/io/fft_wisdom.h"
+#include "oefmt/io/run_setup.h"
 #include "oefmt/ros/rectification.h"
 
 namespace oefmt {
@@ -229,21 +230,19 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
   }
   // The camera of the frames as registered (set up as oefmt_offline does): camera_info's
   // calibration, or ~camera_fx, mapped to the image size, its lens distortion undone.
-  std::optional<CameraParameters> calibration;
-  std::string source = "camera_info";
+  CameraSources sources;
   if (info && info->K[0] > 0.0 && info->K[4] > 0.0) {
     try {
-      calibration = cameraFromInfo(*info);
+      sources.calibration = cameraFromInfo(*info);
     } catch (const BagError& e) {
       throw InputError(std::string("camera_info: ") + e.what());
     }
-    if (!parameters_.undistort) calibration->distortion = Distortion{};
-  } else if (estimator_config_.camera_fx > 0.0) {
-    calibration = pinholeCamera(estimator_config_.camera_fx, image.size());
-    source = "~camera_fx";
+    sources.calibration_source = "camera_info";
   }
-  if (calibration) {
-    updateUndistorter(*calibration, source, image.size());
+  sources.camera_fx = estimator_config_.camera_fx;
+  sources.undistort = parameters_.undistort;
+  if (const auto chosen = chooseCamera(sources, image.size())) {
+    updateUndistorter(chosen->camera, chosen->source, image.size());
   } else {
     undistorter_.reset();
   }
@@ -266,14 +265,12 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     config.working_fx = working_fx;
     // The initial altitude: the altitude topic when asked for, else ~initial_altitude (the
     // configuration file's, or the launch argument's).
-    if (parameters_.use_altitude_topic) {
-      if (!altitude_topic) {
-        ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": waiting for a valid "
-                                                    << nh_.resolveName("altitude") << " range");
-        return false;
-      }
-      config.initial_altitude = *altitude_topic;
+    if (parameters_.use_altitude_topic && !altitude_topic) {
+      ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": waiting for a valid "
+                                                  << nh_.resolveName("altitude") << " range");
+      return false;
     }
+    config.initial_altitude = chooseInitialAltitude(altitude_topic, config.initial_altitude);
     estimator_ = std::make_unique<Estimator>(config);
     lookUpCameraMount(frame);
     estimator_fx_ = working_fx;

@@ -28,6 +28,7 @@
 #include "oefmt/io/tum.h"
 #include "oefmt/io/undistortion.h"
 #include "oefmt/io/fft_wisdom.h"
+#include "oefmt/io/run_setup.h"
 
 namespace {
 
@@ -145,7 +146,8 @@ int main(int argc, char** argv) {
     oefmt::EstimatorConfig config =
         options.config.empty() ? oefmt::EstimatorConfig{} : oefmt::loadConfig(options.config);
     if (options.mode) config.mode = *options.mode;
-    if (options.altitude > 0.0) config.initial_altitude = options.altitude;
+    config.initial_altitude = oefmt::chooseInitialAltitude(
+        options.altitude > 0.0 ? std::optional<double>(options.altitude) : std::nullopt, config.initial_altitude);
     config.validate();
 
     std::unique_ptr<oefmt::FrameSource> opened =
@@ -163,30 +165,16 @@ int main(int argc, char** argv) {
     // lens distortion undone (the node sets up the same, so both register the same frames).
     std::shared_ptr<const oefmt::Undistorter> undistorter;
     if (!image_size.empty()) {
-      std::optional<oefmt::CameraParameters> calibration = opened->calibration();
-      std::string source = opened->calibrationSource();
-      if (options.fx > 0.0) {
-        // --fx is the images' focal length: it replaces the calibration's (mapped to the images).
-        oefmt::CameraParameters camera = oefmt::pinholeCamera(options.fx, image_size);
-        if (calibration) {
-          const oefmt::Intrinsics& k = calibration->intrinsics;
-          if (k.width > 0 && k.height > 0) {
-            const oefmt::Intrinsics mapped = oefmt::intrinsicsForImageSize(k, image_size);
-            camera.intrinsics.cx = mapped.cx;
-            camera.intrinsics.cy = mapped.cy;
-          }
-          camera.distortion = calibration->distortion;
-        }
-        calibration = camera;
-        source = "--fx";
-      } else if (!calibration && config.camera_fx > 0.0) {
-        calibration = oefmt::pinholeCamera(config.camera_fx, image_size);
-        source = "camera_fx";
-      }
-      if (calibration) {
-        if (!options.undistort) calibration->distortion = oefmt::Distortion{};
-        undistorter = std::make_shared<const oefmt::Undistorter>(*calibration, image_size,
-                                                                 config.registration.size, source);
+      oefmt::CameraSources sources;
+      sources.calibration = opened->calibration();
+      sources.calibration_source = opened->calibrationSource();
+      sources.override_fx = options.fx > 0.0 ? options.fx : 0.0;
+      sources.override_source = "--fx";
+      sources.camera_fx = config.camera_fx;
+      sources.undistort = options.undistort;
+      if (const auto chosen = oefmt::chooseCamera(sources, image_size)) {
+        undistorter = std::make_shared<const oefmt::Undistorter>(chosen->camera, image_size,
+                                                                 config.registration.size, chosen->source);
         config.working_fx = undistorter->workingFx();
       }
     }
