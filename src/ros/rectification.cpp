@@ -2,29 +2,21 @@
 #include "oefmt/ros/rectification.h"
 
 #include <opencv2/imgproc.hpp>
-#include <sensor_msgs/distortion_models.h>
 
 #include "oefmt/error.h"
+#include "oefmt/ros/bag_io.h"
 
 namespace oefmt {
 
 sensor_msgs::CameraInfo workingFrameInfo(const Undistorter& undistorter) {
   if (!undistorter.remaps()) throw InputError("no lens distortion to undo: no working frame to rectify");
-  const Intrinsics& k = undistorter.sourceCamera().intrinsics;
-  const Distortion& d = undistorter.sourceCamera().distortion;
   const Intrinsics& out = undistorter.intrinsics();
-  sensor_msgs::CameraInfo info;
+  // The source camera's K and lens, the working frame's size and projection.
+  // (Any valid stamp: the header is cleared, the working frame belongs to no message.)
+  sensor_msgs::CameraInfo info = cameraInfoMessage(undistorter.sourceCamera(), 1.0, "");
+  info.header = std_msgs::Header();
   info.width = static_cast<std::uint32_t>(out.width);
   info.height = static_cast<std::uint32_t>(out.height);
-  if (d.rational()) {
-    info.distortion_model = sensor_msgs::distortion_models::RATIONAL_POLYNOMIAL;
-    info.D = {d.k1, d.k2, d.p1, d.p2, d.k3, d.k4, d.k5, d.k6};
-  } else {
-    info.distortion_model = sensor_msgs::distortion_models::PLUMB_BOB;
-    info.D = {d.k1, d.k2, d.p1, d.p2, d.k3};
-  }
-  info.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
-  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
   info.P = {out.fx, 0.0, out.cx, 0.0, 0.0, out.fy, out.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
   return info;
 }
