@@ -11,6 +11,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "support/package_files.h"
 #include "oefmt/ros/node_parameters.h"
 #include "oefmt/ros/parameter_server.h"
 #include "parameter_doc.h"
@@ -20,12 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path packageRoot() { return fs::path(__FILE__).parent_path().parent_path().parent_path(); }
-
-std::string readFile(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-}
+using test::packageRoot;
+using test::readFile;
 
 TEST(ParameterDoc, DocParametersMdIsTheGeneratedOne) {
   EXPECT_EQ(readFile(packageRoot() / "doc" / "parameters.md"), parametersMarkdown())

@@ -16,6 +16,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "support/package_files.h"
 #include "support/temp_dir.h"
 #include "oefmt/io/dataset.h"
 #include "oefmt/ros/bag_io.h"
@@ -31,12 +32,7 @@ struct ToolRun {
   std::string err;
 };
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using test::readFile;
 
 // Runs `command` (a tool path and arguments, no shell characters) and collects its output.
 ToolRun run(const TempDir& dir, const std::string& command) {

@@ -13,19 +13,15 @@
 #include "oefmt/io/config_file.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "support/package_files.h"
 
 namespace oefmt {
 namespace {
 
 namespace fs = std::filesystem;
 
-// The package root, from this file's path (test/unit/...).
-fs::path packageRoot() { return fs::path(__FILE__).parent_path().parent_path().parent_path(); }
-
-std::string readFile(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-}
+using test::packageRoot;
+using test::readFile;
 
 TEST(EstimatorConfig, DefaultYamlIsTheGeneratedOne) {
   const fs::path path = packageRoot() / "config" / "default.yaml";
