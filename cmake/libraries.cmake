@@ -32,10 +32,11 @@ oefmt_layer_library(oefmt_estimation estimation)
 target_link_libraries(oefmt_estimation PUBLIC oefmt_registration Eigen3::Eigen Ceres::ceres)
 
 oefmt_layer_library(oefmt_io io)
-# libspng decodes PNG files, OpenCV's imgcodecs the other formats (src/io/image_decoding.cpp);
+# libspng decodes PNG files (libdeflate inflates the fast path's 8-bit colour ones, see
+# src/io/png_decoders.h), OpenCV's imgcodecs the other formats (src/io/image_decoding.cpp);
 # yaml-cpp reads the configuration file and cam_param.yaml (src/io/yaml_document.h).
 target_link_libraries(oefmt_io PUBLIC oefmt_estimation opencv_calib3d
-                               PRIVATE opencv_imgcodecs PkgConfig::SPNG yaml-cpp)
+                               PRIVATE opencv_imgcodecs PkgConfig::SPNG PkgConfig::LIBDEFLATE yaml-cpp)
 
 oefmt_layer_library(oefmt_evaluation evaluation)
 target_link_libraries(oefmt_evaluation PUBLIC oefmt_io Eigen3::Eigen)

@@ -1,13 +1,14 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Arbitrary bytes as a camera image -> prepareImage and Registrar::analyse. Inputs that start
-// like a PNG or JPEG file go through oefmt::decodeImage first (the dataset folders' path: libspng
-// for PNGs), and where cv::imdecode (libpng for PNGs) also decodes them, the pictures must be
-// identical; anything else is read as a raw image: a header byte picks the pixel type, two more
+// like a PNG or JPEG file go through oefmt::decodeImage first (the dataset folders' path: the
+// fast path or libspng for PNGs), and where cv::imdecode (libpng for PNGs) also decodes them, the
+// pictures must be identical, as must the fast path's and libspng's wherever both decode; anything else is read as a raw image: a header byte picks the pixel type, two more
 // the size, and the rest are the pixels (float types take the bytes as bit patterns: NaN, inf,
 // denormals).
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include <fuzzer/FuzzedDataProvider.h>
@@ -15,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fuzz_check.h"
+#include "io/png_decoders.h"
 #include "oefmt/error.h"
 #include "oefmt/io/image_decoding.h"
 #include "oefmt/registration/image_prep.h"
@@ -113,6 +115,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                         "decodeImage: type or size differs from cv::imdecode");
       oefmt_fuzz::check(cv::norm(reference, decoded, cv::NORM_INF) == 0.0,
                         "decodeImage: pixels differ from cv::imdecode");
+    }
+    if (const std::optional<cv::Mat> fast = oefmt::detail::decodeColourPngFast(data, size)) {
+      cv::Mat libspng;
+      try {
+        libspng = oefmt::detail::decodePngLibspng(data, size);
+      } catch (const oefmt::InputError&) {
+        // An ancillary chunk libspng is stricter about than libpng (and the fast path): allowed.
+      }
+      if (!libspng.empty()) {
+        oefmt_fuzz::check(libspng.type() == fast->type() && libspng.size() == fast->size() &&
+                              cv::norm(libspng, *fast, cv::NORM_INF) == 0.0,
+                          "PNG fast path: picture differs from libspng's");
+      }
     }
     analyse(decoded);
     return 0;

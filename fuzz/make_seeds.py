@@ -24,14 +24,33 @@ def tail(*values):
     return bytes(reversed(out))
 
 
-def png(width, height, pixel):
-    """An 8-bit greyscale PNG with pixel(x, y) in 0..255."""
-    raw = b"".join(b"\0" + bytes(pixel(x, y) for x in range(width)) for y in range(height))
+def png(width, height, pixel, channels=1):
+    """An 8-bit grey (channels 1) or RGB (3) PNG with pixel(x, y) in 0..255 in every channel, each
+    row with one of the five filters (RGB: the decoders' fast path)."""
+    def row(y):
+        samples = bytes(pixel(x, y) for x in range(width) for _ in range(channels))
+        if channels == 1:
+            return b"\0" + samples
+        kind = y % 5
+        out = bytearray([kind])
+        for i, value in enumerate(samples):
+            a = samples[i - channels] if i >= channels else 0
+            b = rows[y - 1][i] if y > 0 else 0
+            c = rows[y - 1][i - channels] if y > 0 and i >= channels else 0
+            p = a + b - c
+            paeth = a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c
+            predictor = [0, a, b, (a + b) // 2, paeth][kind]
+            out.append((value - predictor) & 255)
+        rows.append(samples)
+        return bytes(out)
+
+    rows = []
+    raw = b"".join(row(y) for y in range(height))
 
     def chunk(kind, body):
         return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
 
-    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    header = struct.pack(">IIBBBBB", width, height, 8, 0 if channels == 1 else 2, 0, 0, 0)
     return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw, 9))
             + chunk(b"IEND", b""))
 
@@ -48,6 +67,7 @@ def write(target, name, data):
 
 def image_seeds():
     write("fuzz_image", "grey16x16.png", png(16, 16, texture))
+    write("fuzz_image", "rgb21x9.png", png(21, 9, texture, channels=3))
     noise = bytes(random.Random(1).randrange(256) for _ in range(256))
     # Raw images: type index (0..5 = 8UC1, 8UC3, 8UC4, 16UC1, 32FC1, 64FC1), cols - 1, rows - 1.
     write("fuzz_image", "raw_8uc1_40x30", noise + tail((0, 1), (39, 2), (29, 2)))

@@ -16,7 +16,7 @@ packages=(
   build-essential cmake pkg-config catkin ros-base-dev libroscpp-dev libnodelet-dev
   libcv-bridge-dev libimage-geometry-dev libimage-transport-dev libtf2-ros-dev libtf2-geometry-msgs-dev librosbag-dev
   ros-nav-msgs ros-sensor-msgs ros-geometry-msgs ros-message-generation ros-message-runtime
-  libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev libspng-dev
+  libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev libspng-dev libdeflate-dev
   libcli11-dev zlib1g-dev libyaml-cpp-dev
   libgtest-dev libbenchmark-dev librostest-dev python3-rostest python3-roslaunch python3-rosbag
   rosbash python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Image file decoding for dataset folders and the simulator's textures: PNG (what simulators and
-// recorders mostly write) through libspng, every other format (JPEG, TIFF, BMP, ...) through
+// recorders mostly write) through libspng, 8-bit colour PNGs through a faster decoder of the
+// package's own (src/io/png_decoders.h), every other format (JPEG, TIFF, BMP, ...) through
 // OpenCV's imgcodecs. Either way the result is the picture cv::imdecode(IMREAD_UNCHANGED) gives.
 #pragma once
 
