@@ -18,9 +18,14 @@ inline void requireInput(bool ok, const std::string& message) {
   if (!ok) throw InputError(message);
 }
 
-/// A configuration value's check: an InputError "invalid parameter 'FIELD': RULE" unless `ok`.
+/// A configuration value refused: the InputError "invalid parameter 'KEY': WHY".
+[[noreturn]] inline void throwInvalidParameter(const std::string& key, const std::string& why) {
+  throw InputError("invalid parameter '" + key + "': " + why);
+}
+
+/// A configuration value's check: throwInvalidParameter(field, rule) unless `ok`.
 inline void requireParameter(bool ok, const std::string& field, const std::string& rule) {
-  if (!ok) throw InputError("invalid parameter '" + field + "': " + rule);
+  if (!ok) throwInvalidParameter(field, rule);
 }
 
 }  // namespace oefmt

@@ -246,8 +246,4 @@ void checkParameters(const ParameterTable& table, const std::string& prefix) {
   }
 }
 
-void throwInvalidParameter(const std::string& key, const std::string& why) {
-  throw InputError("invalid parameter '" + key + "': " + why);
-}
-
 }  // namespace oefmt

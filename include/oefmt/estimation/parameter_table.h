@@ -113,7 +113,5 @@ bool isParameterSection(const ParameterTable& table, const std::string& section)
 /// Throws InputError "invalid parameter '<key>': <problem>" for the first row whose value is not
 /// accepted (rows whose key starts with `prefix` only).
 void checkParameters(const ParameterTable& table, const std::string& prefix = "");
-/// "invalid parameter '<key>': <why>"
-[[noreturn]] void throwInvalidParameter(const std::string& key, const std::string& why);
 
 }  // namespace oefmt
