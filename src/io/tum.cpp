@@ -67,4 +67,12 @@ std::string toTumLine(const Pose4& pose) {
   return line;
 }
 
+std::string toTumLine(const Pose4& pose, const CameraTilt& tilt) {
+  const Eigen::Quaterniond q = cameraBodyOrientation(pose.yaw, tilt);
+  char line[256];
+  std::snprintf(line, sizeof(line), "%.9f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.stamp, pose.x, pose.y, pose.z,
+                q.x(), q.y(), q.z(), q.w());
+  return line;
+}
+
 }  // namespace oefmt

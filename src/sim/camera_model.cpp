@@ -68,6 +68,22 @@ cv::Matx33d opticalToWorld(double yaw) {
                      0.0, 0.0, -1.0);
 }
 
+cv::Matx33d bodyToWorld(const FlightPose& pose) {
+  const double cz = std::cos(pose.yaw), sz = std::sin(pose.yaw);
+  const double cy = std::cos(pose.pitch), sy = std::sin(pose.pitch);
+  const double cx = std::cos(pose.roll), sx = std::sin(pose.roll);
+  const cv::Matx33d z(cz, -sz, 0.0, sz, cz, 0.0, 0.0, 0.0, 1.0);
+  const cv::Matx33d y(cy, 0.0, sy, 0.0, 1.0, 0.0, -sy, 0.0, cy);
+  const cv::Matx33d x(1.0, 0.0, 0.0, 0.0, cx, -sx, 0.0, sx, cx);
+  return z * y * x;
+}
+
+cv::Matx33d opticalToWorld(const FlightPose& pose) {
+  // A level pose's rotation exactly as before tilt existed: level flights render bit-identically.
+  if (pose.level()) return opticalToWorld(pose.yaw);
+  return bodyToWorld(pose) * cv::Matx33d(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0);
+}
+
 cv::Point2d distortNormalised(const Distortion& d, cv::Point2d p) {
   return p * radialFactor(d, p.x * p.x + p.y * p.y) + tangentialTerm(d, p);
 }
@@ -90,9 +106,10 @@ cv::Point2d pixelOnPlane(const CameraParameters& camera, const FlightPose& pose,
   const Intrinsics& k = camera.intrinsics;
   const cv::Point2d n = undistortNormalised(
       camera.distortion, {(pixel.x - k.cx) / k.fx, (pixel.y - k.cy) / k.fy});
-  const cv::Vec3d ray = opticalToWorld(pose.yaw) * cv::Vec3d(n.x, n.y, 1.0);
+  const cv::Vec3d ray = opticalToWorld(pose) * cv::Vec3d(n.x, n.y, 1.0);
   const double depth = pose.position[2] - plane_height;
   if (!(depth > 0.0)) throw InputError("the camera must be above the plane z = " + std::to_string(plane_height));
+  if (!(ray[2] < 0.0)) throw InputError("a pixel's ray does not meet the plane: the camera is tilted too far");
   const double t = depth / -ray[2];
   return {pose.position[0] + t * ray[0], pose.position[1] + t * ray[1]};
 }

@@ -159,6 +159,20 @@ FlightPlan planFlight(const FlightOptions& o) {
     throw InputError("rate and start time must be > 0");
   }
   for (std::size_t i = 0; i < plan.poses.size(); ++i) plan.stamps.push_back(o.start_time + i / o.rate);
+  plan.rate = o.rate;
+  o.imu.validate();
+  o.range.validate();
+  plan.tilt = o.tilt;
+  plan.imu = o.imu;
+  plan.range = o.range;
+  if (o.tilt.any()) {
+    const VehicleMotion motion = vehicleMotion(plan);
+    for (std::size_t i = 0; i < plan.poses.size(); ++i) {
+      const FlightPose tilted = motion.poseAt(plan.stamps[i]);
+      plan.poses[i].pitch = tilted.pitch;
+      plan.poses[i].roll = tilted.roll;
+    }
+  }
 
   requireAboveTops(plan);
   plan.ground_overlap = consecutiveOverlap(plan.camera, plan.poses, 0.0);
@@ -193,10 +207,25 @@ cv::Mat1b sensorImage(const cv::Mat1f& rendered, const SensorOptions& sensor, st
   return out;
 }
 
-void renderFlight(const FlightPlan& plan, const FrameSink& sink) {
+VehicleMotion vehicleMotion(const FlightPlan& plan) {
+  return VehicleMotion(plan.track, plan.rate, plan.stamps.empty() ? 0.0 : plan.stamps.front(), plan.tilt,
+                       plan.scene.seed);
+}
+
+std::vector<ImuSample> simulateFlightImu(const FlightPlan& plan) {
+  if (plan.stamps.empty()) return {};
+  return simulateImu(vehicleMotion(plan), plan.stamps.front(), plan.stamps.back(), plan.imu, plan.scene.seed);
+}
+
+void renderFlight(const FlightPlan& plan, const FrameSink& sink, std::vector<RangeSample>* ranges) {
   const auto scene = std::make_shared<const Scene>(plan.scene);
   const Renderer renderer(scene, plan.camera, plan.supersample);
+  if (ranges) ranges->clear();
   for (std::size_t k = 0; k < plan.poses.size(); ++k) {
+    if (ranges) {
+      ranges->push_back({plan.stamps[k], simulateRange(*scene, plan.poses[k], plan.range, plan.scene.seed,
+                                                        static_cast<int>(k))});
+    }
     const RenderedFrame frame = renderer.render(plan.poses[k]);
     sink(static_cast<int>(k), sensorImage(frame.image, plan.sensor, plan.scene.seed, static_cast<int>(k)),
          frame.layers);
@@ -214,8 +243,10 @@ std::vector<std::string> groundTruthHeader(const FlightPlan& plan) {
       "oefmt_simulate ground truth, one line per frame: t x y z qx qy qz qw",
       "t: seconds (same stamps as timestamps.txt and the bag); x y z: metres",
       "world frame (REP-103, ENU): x east, y north, z up; ground plane at z = 0",
-      "pose of the camera body (base_link): position and yaw about z (roll = pitch = 0)",
-      "the camera looks straight down: base_link -> camera optical frame is a 180 deg turn about x",
+      plan.tilt.any() ? "pose of the camera body (base_link): position and attitude (tilted as a multirotor)"
+                      : "pose of the camera body (base_link): position and yaw about z (roll = pitch = 0)",
+      plan.tilt.any() ? "the camera looks down the body's -z: base_link -> camera optical frame is a 180 deg turn about x"
+                      : "the camera looks straight down: base_link -> camera optical frame is a 180 deg turn about x",
       "(quaternion x=1 y=0 z=0 w=0), so at yaw 0 image right = +x (east), image up = +y (north)",
       std::string("track ") + toString(t.shape) + ", " + std::to_string(plan.poses.size()) + " frames" + shape,
   };

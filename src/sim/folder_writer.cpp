@@ -17,6 +17,10 @@ StampedPose toStampedPose(const FlightPose& pose, double stamp) {
   out.stamp = stamp;
   out.position = Eigen::Vector3d(pose.position[0], pose.position[1], pose.position[2]);
   out.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(pose.yaw, Eigen::Vector3d::UnitZ()));
+  if (!pose.level()) {
+    out.orientation = out.orientation * Eigen::AngleAxisd(pose.pitch, Eigen::Vector3d::UnitY()) *
+                      Eigen::AngleAxisd(pose.roll, Eigen::Vector3d::UnitX());
+  }
   return out;
 }
 

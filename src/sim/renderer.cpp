@@ -40,6 +40,8 @@ RenderedFrame Renderer::render(const FlightPose& pose) const {
   const Intrinsics& k = camera_.intrinsics;
   const int samples = supersample_ * supersample_;
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  const cv::Matx33d rotation = opticalToWorld(pose);
+  const bool level = pose.level();
   const cv::Vec3d origin = pose.position;
   RenderedFrame frame;
   frame.image.create(k.height, k.width);
@@ -54,9 +56,10 @@ RenderedFrame Renderer::render(const FlightPose& pose) const {
         int first_layer = -1;
         bool mixed = false;
         for (int q = 0; q < samples; ++q, ++ray) {
-          // opticalToWorld(yaw) * (x, y, 1).
+          // opticalToWorld(pose) * (x, y, 1); level poses keep the shorter form they always had.
           const double x = (*ray)[0], y = (*ray)[1];
-          const SceneHit hit = scene.cast(origin, cv::Vec3d(c * x + s * y, s * x - c * y, -1.0));
+          const SceneHit hit = scene.cast(origin, level ? cv::Vec3d(c * x + s * y, s * x - c * y, -1.0)
+                                                        : rotation * cv::Vec3d(x, y, 1.0));
           sum += scene.shade(hit);
           const int code = hit.onWall() ? RenderedFrame::kWallLayers + hit.layer : hit.layer;
           if (first_layer < 0) first_layer = code;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "oefmt/error.h"
 
@@ -33,6 +34,8 @@ double unitSpeed(const TrackConfig& config, double u) {
   }
   return 1.0;
 }
+
+}  // namespace
 
 // Arc length of the unit shape at u = k / (samples - 1) (Simpson's rule on the speed: exact for
 // the circle and the line), to walk it at constant speed.
@@ -65,18 +68,6 @@ struct ArcTable {
   }
 };
 
-// A spin: the camera stays at the origin and turns.
-std::vector<FlightPose> makeSpin(const TrackConfig& config) {
-  std::vector<FlightPose> poses(config.frames);
-  for (int k = 0; k < config.frames; ++k) {
-    poses[k].position = cv::Vec3d(0.0, 0.0, config.altitude);
-    poses[k].yaw = std::remainder(config.yaw + k * config.spin_rate, 2.0 * CV_PI);
-  }
-  return poses;
-}
-
-}  // namespace
-
 void TrackConfig::validate() const {
   if (isMoving(shape)) {
     requireInput(length > 0.0 && std::isfinite(length), "track: length must be > 0");
@@ -106,33 +97,50 @@ double frameSpacing(const TrackConfig& config) {
   return isMoving(config.shape) ? config.length / (config.frames - 1) : 0.0;
 }
 
-std::vector<FlightPose> makeTrack(const TrackConfig& config) {
-  config.validate();
-  if (!isMoving(config.shape)) return makeSpin(config);
-  const bool hill = resolvedClimbProfile(config) == ClimbProfile::kHill;
-  const ArcTable table(config);
-  const double scale = config.length / table.total();
-  const double step = frameSpacing(config);
-  std::vector<FlightPose> poses;
-  for (int k = 0; k < config.frames; ++k) {
-    const double s = k == config.frames - 1 ? config.length : k * step;  // exact closure
-    const double fraction = s / config.length;
-    const double u = table.at(s / scale);
-    FlightPose pose;
-    const cv::Point2d p = unitShape(config, u) * scale;
-    const double profile = hill ? 0.5 * (1.0 - std::cos(2.0 * CV_PI * fraction)) : fraction;
-    pose.position = cv::Vec3d(p.x, p.y, config.altitude + config.climb * profile);
-    pose.yaw = config.yaw;
-    if (config.heading == HeadingMode::kTrack) {
-      // Direction of motion from a short chord around u (the shapes are smooth).
-      const double du = 1e-5;
-      const cv::Point2d ahead = unitShape(config, std::min(1.0, u + du));
-      const cv::Point2d behind = unitShape(config, std::max(0.0, u - du));
-      pose.yaw += std::atan2(ahead.y - behind.y, ahead.x - behind.x);
-      pose.yaw = std::remainder(pose.yaw, 2.0 * CV_PI);
-    }
-    poses.push_back(pose);
+TrackPath::TrackPath(const TrackConfig& config) : config_(config) {
+  config_.validate();
+  if (isMoving(config_.shape)) {
+    table_ = std::make_shared<const ArcTable>(config_);
+    scale_ = config_.length / table_->total();
   }
+}
+
+FlightPose TrackPath::at(double k) const {
+  FlightPose pose;
+  if (!isMoving(config_.shape)) {
+    pose.position = cv::Vec3d(0.0, 0.0, config_.altitude);
+    pose.yaw = std::remainder(config_.yaw + k * config_.spin_rate, 2.0 * CV_PI);
+    return pose;
+  }
+  const double last = config_.frames - 1;
+  double s = k == last ? config_.length : k * frameSpacing(config_);  // exact closure
+  if (isClosed(config_.shape) && (s < 0.0 || s > config_.length)) {
+    s -= config_.length * std::floor(s / config_.length);  // loops repeat
+  }
+  const double fraction = s / config_.length;
+  // Lines go on straight beyond their ends (the arc table covers the track itself).
+  const double u = s >= 0.0 && s <= config_.length ? table_->at(s / scale_) : s / config_.length;
+  const cv::Point2d p = unitShape(config_, u) * scale_;
+  const bool hill = resolvedClimbProfile(config_) == ClimbProfile::kHill;
+  const double profile = hill ? 0.5 * (1.0 - std::cos(2.0 * CV_PI * fraction)) : fraction;
+  pose.position = cv::Vec3d(p.x, p.y, config_.altitude + config_.climb * profile);
+  pose.yaw = config_.yaw;
+  if (config_.heading == HeadingMode::kTrack) {
+    // Direction of motion from a short chord around u (the shapes are smooth).
+    const double du = 1e-5;
+    const bool line = !isClosed(config_.shape);
+    const cv::Point2d ahead = unitShape(config_, line && u > 1.0 ? u + du : std::min(1.0, u + du));
+    const cv::Point2d behind = unitShape(config_, line && u < 0.0 ? u - du : std::max(0.0, u - du));
+    pose.yaw += std::atan2(ahead.y - behind.y, ahead.x - behind.x);
+    pose.yaw = std::remainder(pose.yaw, 2.0 * CV_PI);
+  }
+  return pose;
+}
+
+std::vector<FlightPose> makeTrack(const TrackConfig& config) {
+  const TrackPath path(config);
+  std::vector<FlightPose> poses;
+  for (int k = 0; k < config.frames; ++k) poses.push_back(path.at(k));
   if (isClosed(config.shape)) {
     poses.back() = poses.front();  // bit-identical loop closure
   }

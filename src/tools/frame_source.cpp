@@ -77,7 +77,7 @@ void PrefetchingSource::run() {
       if (more) frame.image_size = frame.image.size();
       if (more && analyse_) {
         try {
-          frame.spectra = analyse_(frame.image);
+          analyse_(frame);
         } catch (const InputError& e) {
           throw InputError(frame.name + ": " + e.what());  // which frame, for the user
         }

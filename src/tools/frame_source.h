@@ -17,6 +17,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/estimation/attitude.h"
 #include "oefmt/io/dataset.h"
 #include "oefmt/registration/spectra.h"
 
@@ -28,6 +29,7 @@ struct SourceFrame {
   cv::Mat image;         ///< as decoded; released once `spectra` is made
   cv::Size image_size;   ///< of the decoded image (kept when the image is released)
   FrameSpectra spectra;  ///< made by PrefetchingSource's `analyse`, when it has one
+  std::optional<CameraTilt> tilt;  ///< the camera's roll and pitch when `analyse` undid them
   std::string name;      ///< file name or "bag message k"
 };
 
@@ -57,10 +59,11 @@ std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string&
                                      const std::string& camera_info_topic);
 
 /// Reads ahead from a source on its own thread, at most `depth` frames. With `analyse`, each
-/// frame's spectra are made on that thread too (and the decoded image released).
+/// frame's spectra are made on that thread too (`analyse` sets frame.spectra, and frame.tilt when
+/// it levels the frame; the decoded image is released after it).
 class PrefetchingSource {
  public:
-  using Analyse = std::function<FrameSpectra(const cv::Mat& image)>;
+  using Analyse = std::function<void(SourceFrame& frame)>;
   PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth = 4,
                     Analyse analyse = nullptr);
   ~PrefetchingSource();

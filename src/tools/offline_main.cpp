@@ -4,10 +4,12 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -28,6 +30,8 @@
 #include "oefmt/io/tum.h"
 #include "oefmt/io/undistortion.h"
 #include "oefmt/io/fft_wisdom.h"
+#include "oefmt/io/nadir_view.h"
+#include "oefmt/io/vehicle_data.h"
 #include "oefmt/io/run_setup.h"
 
 namespace {
@@ -39,6 +43,7 @@ struct Options {
   double fx = 0.0;
   long max_frames = -1;
   bool undistort = true;
+  bool use_imu = true;
   bool quiet = false;
 };
 
@@ -85,6 +90,10 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
                         "take the images as undistorted: ignore the lens distortion of\n"
                         "cam_param.yaml/CameraInfo (rectified images, or renders whose\n"
                         "cam_param.yaml is another camera's, as the o-eFMT authors' circle)");
+  app.add_flag_callback("--no-imu", [&o] { o.use_imu = false; },
+                        "ignore the folder's imu.txt (by default, when it is there, each\n"
+                        "frame is turned into a level camera's view with the IMU's roll\n"
+                        "and pitch, and the trajectory carries them)");
   app.add_option("--max-frames", o.max_frames, "stop after N frames")->type_name("N");
   app.add_flag("--quiet", o.quiet, "no progress bar and no summary table");
   app.callback([&o] {
@@ -178,6 +187,29 @@ int main(int argc, char** argv) {
         config.working_fx = undistorter->workingFx();
       }
     }
+    // Attitude-aided registration: a folder's imu.txt (its body frame is the camera body) gives
+    // each frame's roll and pitch, with which the frame is turned into a level camera's view.
+    std::shared_ptr<oefmt::AttitudeHistory> attitudes;
+    std::shared_ptr<const oefmt::NadirView> nadir;
+    const std::string imu_path = options.images.empty() ? "" : options.images + "/" + oefmt::kImuFileName;
+    if (options.use_imu && !imu_path.empty() && std::filesystem::exists(imu_path)) {
+      if (!undistorter) {
+        std::fprintf(stderr, "oefmt_offline: warning: %s ignored: no intrinsics to level the frames with\n",
+                     imu_path.c_str());
+      } else {
+        attitudes = std::make_shared<oefmt::AttitudeHistory>();
+        for (const oefmt::ImuSample& sample : oefmt::readImuFile(imu_path)) {
+          attitudes->add(sample.stamp, sample.orientation);
+        }
+        nadir = std::make_shared<const oefmt::NadirView>(undistorter->inputCamera(), image_size,
+                                                          config.working_fx, config.registration.size);
+        if (!options.quiet) {
+          std::fprintf(stderr, "oefmt_offline: attitude from %s: frames levelled with its roll and pitch\n",
+                       imu_path.c_str());
+        }
+      }
+    }
+    auto unlevelled = std::make_shared<std::atomic<long>>(0);
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
     // one registers the previous frame. Two frames queued let the reader run ahead over a slow
     // frame (one was slower; a second reader thread gained nothing more and cost memory, see
@@ -189,8 +221,19 @@ int main(int argc, char** argv) {
     const auto context = std::make_shared<const oefmt::SpectralContext>(config.registration);
     oefmt::PrefetchingSource source(
         std::move(opened), 2,
-        [builder = oefmt::SpectraBuilder(context), undistorter](const cv::Mat& image) mutable {
-          return builder.build(undistorter ? undistorter->apply(image) : image);
+        [builder = oefmt::SpectraBuilder(context), undistorter, attitudes, nadir,
+         unlevelled](oefmt::SourceFrame& frame) mutable {
+          if (attitudes) {
+            if (const std::optional<Eigen::Quaterniond> body = attitudes->at(frame.stamp)) {
+              // The IMU's body is the camera body: the optical frame is it turned about x.
+              const Eigen::Matrix3d optical = body->toRotationMatrix() * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+              frame.tilt = oefmt::cameraTilt(optical);
+              frame.spectra = builder.build(nadir->apply(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
+              return;
+            }
+            ++*unlevelled;  // no attitude at this stamp: the frame is taken as level
+          }
+          frame.spectra = builder.build(undistorter ? undistorter->apply(frame.image) : frame.image);
         });
 
     trajectory.open(options.output);
@@ -247,11 +290,18 @@ int main(int argc, char** argv) {
       }
       if (estimate->state == oefmt::TrackingState::kRestarted) ++restarts;
       if (estimate->loop.status == oefmt::OptimizerStatus::kFallback) ++fallbacks;
-      trajectory << oefmt::toTumLine(estimate->pose) << '\n';
+      trajectory << (frame.tilt ? oefmt::toTumLine(estimate->pose, *frame.tilt) : oefmt::toTumLine(estimate->pose))
+                 << '\n';
       if (diagnostics.is_open()) writeDiagnosticsLine(diagnostics, *estimate);
       progress.update(static_cast<size_t>(frames));
     }
     progress.finish();
+    if (*unlevelled > 0) {
+      std::fprintf(stderr,
+                   "oefmt_offline: warning: %ld frames had no IMU attitude within 0.1 s of their stamp and were "
+                   "taken as level\n",
+                   unlevelled->load());
+    }
   } catch (const std::exception& e) {
     // Keep and close what was written so far: a partial trajectory is still a valid file.
     std::fprintf(stderr, "oefmt_offline: error: %s\n", e.what());

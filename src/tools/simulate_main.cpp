@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // oefmt_simulate: renders a flight of a down-looking camera over a multi-depth textured scene and
 // writes it in the authors' dataset layout with ground truth (and optionally as a ROS bag).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -16,6 +17,7 @@
 
 #include "command_line.h"
 #include "oefmt/error.h"
+#include "oefmt/io/vehicle_data.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/folder_writer.h"
@@ -32,6 +34,8 @@ struct Command {
   oefmt::BagWriterOptions bag_options;
   int threads = -1;
   bool quiet = false;
+  bool imu = false;    // write imu.txt
+  bool range = false;  // write range.txt
 };
 
 /// LAYER=FILE of --texture into the flight's texture files.
@@ -249,6 +253,29 @@ Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames,
       ->group(sensor);
   app.add_option("--threads", command.threads, "rendering threads (default: all cores)")->type_name("N")->group(sensor);
 
+  const std::string vehicle = "vehicle attitude and sensors";
+  app.add_flag("--tilt", f.tilt.follow_acceleration,
+               "lean into the horizontal acceleration as a multirotor does\n(atan(a / g)); default level")
+      ->group(vehicle);
+  addAngle("--wobble", f.tilt.wobble, "amplitude of a smooth random wobble of roll and pitch (default 0)")
+      ->group(vehicle);
+  addNumber(app, "--wobble-hz", f.tilt.wobble_frequency, "HZ", "the wobble's highest frequency (default 0.5)")
+      ->group(vehicle);
+  addAngle("--max-tilt", f.tilt.max_tilt, "roll and pitch together are clamped to this (default 25)")->group(vehicle);
+  app.add_flag("--imu", command.imu,
+               "write imu.txt: orientation, angular velocity and specific force\nat --imu-rate, with noise, gyro bias "
+               "and attitude error")
+      ->group(vehicle);
+  addNumber(app, "--imu-rate", f.imu.rate, "HZ", "IMU samples per second (default 200)")->group(vehicle);
+  addAngle("--attitude-error", f.imu.attitude_error, "slow wander of the IMU's roll and pitch (default 0.3)")
+      ->group(vehicle);
+  app.add_flag("--range", command.range,
+               "write range.txt: a downward rangefinder's distance at every frame\n(noise, dropouts as inf)")
+      ->group(vehicle);
+  addNumber(app, "--range-noise", f.range.noise, "M", "rangefinder noise std (default 0.03)")->group(vehicle);
+  addNumber(app, "--range-dropout", f.range.dropout, "P", "probability of a reading without return (default 0.02)")
+      ->group(vehicle);
+
   const std::string output = "time and output";
   addNumber(app, "--rate", f.rate, "HZ", "frame rate (default 5)")->group(output);
   addNumber(app, "--start-time", f.start_time, "S", "stamp of the first frame (default 1.0)")->group(output);
@@ -369,6 +396,7 @@ int main(int argc, char** argv) {
     oefmt::tools::ProgressBar progress("rendering", plan.poses.size(), command.quiet ? nullptr : stderr);
     // The written frames' contrast, as the estimator sees it (after sampling, noise and gain).
     double std_sum = 0.0, std_min = HUGE_VAL, std_max = 0.0;
+    std::vector<oefmt::RangeSample> ranges;
     oefmt::sim::renderFlight(plan, [&](int k, const cv::Mat1b& image, const cv::Mat1b&) {
       cv::Scalar mean, std;
       cv::meanStdDev(image, mean, std);
@@ -378,9 +406,19 @@ int main(int argc, char** argv) {
       folder.write(image, plan.poses[k], plan.stamps[k]);
       if (bag) bag->write(image, plan.stamps[k]);
       progress.update(static_cast<std::size_t>(k) + 1);
-    });
+    }, command.range ? &ranges : nullptr);
     progress.finish();
     folder.finish();
+    const std::filesystem::path folder_path(command.output);
+    if (command.imu) {
+      oefmt::writeImuFile((folder_path / oefmt::kImuFileName).string(), oefmt::sim::simulateFlightImu(plan),
+                          {"oefmt_simulate IMU (frame: base_link, the camera body): t qx qy qz qw wx wy wz ax ay az",
+                           "orientation body to world (ENU); angular velocity [rad/s] and specific force [m/s^2] in the body frame"});
+    }
+    if (command.range) {
+      oefmt::writeRangeFile((folder_path / oefmt::kRangeFileName).string(), ranges,
+                            {"oefmt_simulate rangefinder: t range [m] along the body's -z; inf: no return"});
+    }
     if (bag) bag->close();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!command.quiet) {

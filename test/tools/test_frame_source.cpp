@@ -44,12 +44,11 @@ constexpr std::size_t kNever = static_cast<std::size_t>(-1);
 
 // The analysis records the image's value as the texture; `failing_value` makes it throw.
 PrefetchingSource::Analyse recordingAnalysis(float failing_value = -1.0f) {
-  return [failing_value](const cv::Mat& image) {
-    const float value = image.at<float>(0, 0);
+  return [failing_value](SourceFrame& frame) {
+    const float value = frame.image.at<float>(0, 0);
     if (value == failing_value) throw InputError("cannot analyse this image");
-    FrameSpectra spectra;
-    spectra.texture = value;
-    return spectra;
+    frame.spectra = FrameSpectra();
+    frame.spectra.texture = value;
   };
 }
 

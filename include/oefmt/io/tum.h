@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "oefmt/estimation/attitude.h"
 #include "oefmt/estimation/pose.h"
 
 namespace oefmt {
@@ -34,5 +35,7 @@ void writeTum(const std::string& path, const StampedTrajectory& trajectory,
 /// precision (the offline runner writes its trajectory line by line, so nothing is lost when a
 /// run stops early).
 std::string toTumLine(const Pose4& pose);
+/// The same with the camera body's roll and pitch (from an IMU): a 6-DOF pose.
+std::string toTumLine(const Pose4& pose, const CameraTilt& tilt);
 
 }  // namespace oefmt

@@ -2,8 +2,9 @@
 // The simulated down-looking camera: poses, the camera's orientation in the world, distortion.
 //
 // World frame (REP-103): x east, y north, z up. A pose is the body (base_link) pose: position and
-// yaw about z. The camera looks straight down; its optical frame (x right, y down, z forward) is
-// the body frame turned 180 degrees about x, so at yaw 0 image right = +x and image up = +y.
+// attitude (yaw, pitch, roll about z, y', x''). The camera is rigidly mounted looking down the
+// body's -z axis; its optical frame (x right, y down, z forward) is the body frame turned 180
+// degrees about x, so level and at yaw 0 image right = +x and image up = +y.
 #pragma once
 
 #include <vector>
@@ -15,14 +16,25 @@
 namespace oefmt {
 namespace sim {
 
-/// Pose of the camera body: position [m] and yaw [rad] (counter-clockwise seen from above).
+/// Pose of the camera body: position [m], yaw [rad] (counter-clockwise seen from above), and the
+/// tilt of a vehicle without gimbal: pitch about the body's y axis, roll about its x axis [rad]
+/// (zero: level).
 struct FlightPose {
   cv::Vec3d position;
   double yaw = 0.0;
+  double pitch = 0.0;
+  double roll = 0.0;
+
+  bool level() const { return pitch == 0.0 && roll == 0.0; }
 };
 
-/// Rotation of the camera's optical frame into the world: Rz(yaw) * Rx(pi).
+/// Rotation of the body into the world: Rz(yaw) * Ry(pitch) * Rx(roll).
+cv::Matx33d bodyToWorld(const FlightPose& pose);
+
+/// Rotation of the camera's optical frame into the world: Rz(yaw) * Rx(pi) for a level pose,
+/// bodyToWorld(pose) * Rx(pi) in general.
 cv::Matx33d opticalToWorld(double yaw);
+cv::Matx33d opticalToWorld(const FlightPose& pose);
 
 /// Applies the radial-tangential (and rational) model to normalised coordinates (undistorted ->
 /// distorted), as OpenCV does.

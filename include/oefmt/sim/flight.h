@@ -14,6 +14,8 @@
 #include "oefmt/sim/camera_model.h"
 #include "oefmt/sim/scene.h"
 #include "oefmt/sim/track.h"
+#include "oefmt/sim/vehicle_motion.h"
+#include "oefmt/sim/vehicle_sensors.h"
 
 namespace oefmt {
 namespace sim {
@@ -60,6 +62,9 @@ struct FlightOptions {
   SensorOptions sensor;
   double rate = 5.0;          ///< frames per second [Hz]
   double start_time = 1.0;    ///< stamp of the first frame [s] (> 0: ROS bags need it)
+  TiltOptions tilt;           ///< roll and pitch of the body (default: level)
+  ImuOptions imu;
+  RangeOptions range;
 };
 
 /// Altitude of a spin without a given altitude [m] (a spin has no overlap to choose it by).
@@ -80,6 +85,10 @@ struct FlightPlan {
   std::vector<double> stamps;         ///< [s]
   OverlapStatistics ground_overlap;   ///< consecutive frames, on the ground plane
   OverlapStatistics top_overlap;      ///< consecutive frames, on the highest level's plane
+  double rate = 5.0;                  ///< [Hz]
+  TiltOptions tilt;
+  ImuOptions imu;
+  RangeOptions range;
 };
 
 /// Resolves the automatic choices and computes poses, stamps and overlaps.
@@ -95,8 +104,15 @@ cv::Mat1b sensorImage(const cv::Mat1f& rendered, const SensorOptions& sensor, st
 /// Receives frame k: the 8-bit image, and the renderer's layer map.
 using FrameSink = std::function<void(int frame, const cv::Mat1b& image, const cv::Mat1b& layers)>;
 
-/// Builds the scene and renderer of the plan, renders every frame in order and calls `sink`.
-void renderFlight(const FlightPlan& plan, const FrameSink& sink);
+/// Builds the scene and renderer of the plan, renders every frame in order and calls `sink`;
+/// with `ranges`, also gives the rangefinder's reading at every frame.
+void renderFlight(const FlightPlan& plan, const FrameSink& sink, std::vector<RangeSample>* ranges = nullptr);
+
+/// The vehicle's motion between and beyond the frames (what the plan's poses sample).
+VehicleMotion vehicleMotion(const FlightPlan& plan);
+
+/// The IMU's samples over the flight, from its first frame's stamp to its last's.
+std::vector<ImuSample> simulateFlightImu(const FlightPlan& plan);
 
 /// The comment lines of groundtruth.tum: frame, units and conventions.
 std::vector<std::string> groundTruthHeader(const FlightPlan& plan);

@@ -3,6 +3,7 @@
 // spot.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,24 @@ ClimbProfile resolvedClimbProfile(const TrackConfig& config);
 
 /// Distance between consecutive frames [m] (0 for a spin).
 double frameSpacing(const TrackConfig& config);
+
+struct ArcTable;
+
+/// The track as a function of a continuous frame position k (frame k at k = 0, 1, ...; between
+/// and beyond them the same constant-speed motion: loops repeat, lines go on straight, a spin
+/// keeps turning). Level poses.
+class TrackPath {
+ public:
+  /// Throws InputError naming the first invalid field of `config`.
+  explicit TrackPath(const TrackConfig& config);
+  FlightPose at(double k) const;
+  const TrackConfig& config() const { return config_; }
+
+ private:
+  TrackConfig config_;
+  std::shared_ptr<const ArcTable> table_;  // arc length of the unit shape (moving tracks)
+  double scale_ = 1.0;                     // metres per unit of the shape
+};
 
 /// The camera pose of every frame, at equal distances along the track.
 std::vector<FlightPose> makeTrack(const TrackConfig& config);

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The camera's attitude from an IMU, for attitude-aided registration: a tilted camera's frame is
+// turned into the view of a virtual camera at the same place looking straight down, so that the
+// tilt is never read as translation.
+//
+// The camera body is the optical frame turned 180 degrees about x (x image right, y image up, z
+// against the view); level and looking straight down, its z is the world's up. Its attitude is
+// yaw, pitch, roll about z, y', x'' (world <- body = Rz(yaw) Ry(pitch) Rx(roll)). The images give
+// the yaw; the IMU gives pitch and roll, which are measured against gravity and need no compass.
+#pragma once
+
+#include <deque>
+#include <optional>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace oefmt {
+
+struct CameraTilt {
+  double roll = 0.0;   ///< [rad]
+  double pitch = 0.0;  ///< [rad]
+};
+
+/// The tilt of a camera whose optical frame turns into the world by `world_from_optical`.
+CameraTilt cameraTilt(const Eigen::Matrix3d& world_from_optical);
+
+/// The rotation from the tilted camera's optical frame to the virtual nadir camera's: the same
+/// yaw, no tilt.
+Eigen::Matrix3d nadirFromOptical(const CameraTilt& tilt);
+
+/// The camera body's orientation (body to world) of a yaw and a tilt.
+Eigen::Quaterniond cameraBodyOrientation(double yaw, const CameraTilt& tilt);
+
+/// Orientations of a body (body to world) over time, as an IMU or attitude filter gives them,
+/// read at any stamp between two of them by spherical interpolation.
+class AttitudeHistory {
+ public:
+  /// max_gap: two samples further apart than this [s] do not bracket a stamp (a gap in the data
+  /// is no information about what happened in it).
+  explicit AttitudeHistory(double max_gap = 0.1);
+
+  /// Adds a sample; one not after the newest is ignored (returns false).
+  bool add(double stamp, const Eigen::Quaterniond& body_to_world);
+  /// The orientation at `stamp`: interpolated between the samples just before and after it, or
+  /// a sample at it; nullopt when no pair within max_gap brackets it.
+  std::optional<Eigen::Quaterniond> at(double stamp) const;
+  /// Drops samples no longer needed for stamps from `stamp` on.
+  void forgetBefore(double stamp);
+
+  bool empty() const { return samples_.empty(); }
+  double newestStamp() const { return samples_.empty() ? -1.0 : samples_.back().stamp; }
+
+ private:
+  struct Sample {
+    double stamp;
+    Eigen::Quaterniond orientation;
+  };
+  double max_gap_;
+  std::deque<Sample> samples_;
+};
+
+}  // namespace oefmt

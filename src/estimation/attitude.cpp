@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/estimation/attitude.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace oefmt {
+namespace {
+
+// The optical frame turned 180 degrees about x: the camera body (and back; its own inverse).
+const Eigen::Matrix3d& flipX() {
+  static const Eigen::Matrix3d flip = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  return flip;
+}
+
+Eigen::Matrix3d tiltRotation(const CameraTilt& tilt) {
+  return (Eigen::AngleAxisd(tilt.pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(tilt.roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+}  // namespace
+
+CameraTilt cameraTilt(const Eigen::Matrix3d& world_from_optical) {
+  const Eigen::Matrix3d body = world_from_optical * flipX();
+  // Rz(yaw) Ry(pitch) Rx(roll): row 2 is (-sin p, cos p sin r, cos p cos r), free of the yaw.
+  CameraTilt tilt;
+  tilt.pitch = std::asin(std::clamp(-body(2, 0), -1.0, 1.0));
+  tilt.roll = std::atan2(body(2, 1), body(2, 2));
+  return tilt;
+}
+
+Eigen::Matrix3d nadirFromOptical(const CameraTilt& tilt) {
+  // world <- virtual optical = Rz(yaw) F, world <- optical = Rz(yaw) T F (F = flipX, T the tilt):
+  // virtual <- optical = F T F.
+  return flipX() * tiltRotation(tilt) * flipX();
+}
+
+Eigen::Quaterniond cameraBodyOrientation(double yaw, const CameraTilt& tilt) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * tiltRotation(tilt)).normalized();
+}
+
+AttitudeHistory::AttitudeHistory(double max_gap) : max_gap_(max_gap) {}
+
+bool AttitudeHistory::add(double stamp, const Eigen::Quaterniond& body_to_world) {
+  if (!std::isfinite(stamp) || !body_to_world.coeffs().allFinite() || !(body_to_world.norm() > 1e-6)) return false;
+  if (!samples_.empty() && !(stamp > samples_.back().stamp)) return false;
+  samples_.push_back({stamp, body_to_world.normalized()});
+  return true;
+}
+
+std::optional<Eigen::Quaterniond> AttitudeHistory::at(double stamp) const {
+  const auto after = std::lower_bound(samples_.begin(), samples_.end(), stamp,
+                                      [](const Sample& s, double t) { return s.stamp < t; });
+  if (after == samples_.end()) return std::nullopt;
+  if (after->stamp == stamp) return after->orientation;
+  if (after == samples_.begin()) return std::nullopt;
+  const Sample& before = *(after - 1);
+  const double span = after->stamp - before.stamp;
+  if (!(span <= max_gap_)) return std::nullopt;
+  return before.orientation.slerp((stamp - before.stamp) / span, after->orientation);
+}
+
+void AttitudeHistory::forgetBefore(double stamp) {
+  // Keep the last sample before `stamp`: it brackets stamps just after it.
+  while (samples_.size() > 1 && samples_[1].stamp <= stamp) samples_.pop_front();
+}
+
+}  // namespace oefmt
