@@ -577,6 +577,21 @@ void Estimator::reset() {
 }
 
 const Pose4& Estimator::pose() const { return state_->integrator.pose(); }
+
+double Estimator::altitude() const { return state_->integrator.altitude(); }
+
+void Estimator::observeAltitude(double altitude, double sigma, double drift_variance) {
+  State& s = *state_;
+  const double before = s.integrator.pose().z;
+  if (drift_variance > 0.0 && std::isfinite(drift_variance)) {
+    Pose4 widened = s.integrator.pose();
+    widened.covariance(2, 2) += drift_variance;
+    s.integrator.restore(widened);
+  }
+  s.integrator.correctAltitude(altitude, sigma * sigma);
+  // Predictions made while frames failed are undone from the anchor: it moves alike.
+  if (s.anchor) s.anchor->z += s.integrator.pose().z - before;
+}
 double Estimator::shiftPerBin() const { return state_->registrar.shiftPerBin(); }
 double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
 

@@ -58,6 +58,19 @@ void PoseIntegrator::reset(double stamp) {
   last_step_covariance_ = cv::Matx44d::zeros();
 }
 
+void PoseIntegrator::correctAltitude(double altitude, double variance) {
+  if (!std::isfinite(altitude) || !(altitude > 0.0) || !std::isfinite(variance) || !(variance > 0.0)) return;
+  const double prior = pose_.covariance(2, 2);
+  // A pose with no variance yet (the first frame) takes the measurement as it is.
+  const double gain = prior > 0.0 ? prior / (prior + variance) : 1.0;
+  pose_.z += gain * (altitude - this->altitude());
+  // Joseph-free form for a scalar measurement of one state: P <- P - K H P.
+  const cv::Matx44d p = pose_.covariance;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) pose_.covariance(r, c) = p(r, c) - (prior > 0.0 ? p(r, 2) * p(2, c) / (prior + variance) : 0.0);
+  }
+}
+
 const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
   using Mat4 = Eigen::Matrix4d;
   using Vec2 = Eigen::Vector2d;

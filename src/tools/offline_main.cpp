@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -23,6 +24,7 @@
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "oefmt/estimation/range_gate.h"
 #include "oefmt/io/config_file.h"
 #include "oefmt/registration/image_prep.h"
 #include "progress.h"
@@ -44,6 +46,7 @@ struct Options {
   long max_frames = -1;
   bool undistort = true;
   bool use_imu = true;
+  bool use_range = true;
   bool quiet = false;
 };
 
@@ -94,6 +97,9 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
                         "ignore the folder's imu.txt (by default, when it is there, each\n"
                         "frame is turned into a level camera's view with the IMU's roll\n"
                         "and pitch, and the trajectory carries them)");
+  app.add_flag_callback("--no-range", [&o] { o.use_range = false; },
+                        "ignore the folder's range.txt (by default, when it is there, its\n"
+                        "readings give the initial altitude and keep the scale metric)");
   app.add_option("--max-frames", o.max_frames, "stop after N frames")->type_name("N");
   app.add_flag("--quiet", o.quiet, "no progress bar and no summary table");
   app.callback([&o] {
@@ -103,6 +109,43 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
     oefmt::requireInput(o.fx >= 0.0, "--fx must be > 0");
   });
   return oefmt::tools::parseCommandLine(app, argc, argv);
+}
+
+// A rangefinder reading's standard deviation [m], for the altitude correction.
+constexpr double kRangeSigma = 0.05;
+// The camera's tilt is known to about this [rad] (a typical attitude filter's accuracy, or a level
+// mount's): a step of length L may then climb or descend L times it unseen by the images' zoom.
+constexpr double kAttitudeSigma = 0.5 * M_PI / 180.0;
+// Frames run ahead to find the rangefinder's scale.
+constexpr std::size_t kScaleFrames = 20;
+
+// A deep copy: the estimator warps a frame's grey image in place when it becomes the older one.
+oefmt::FrameSpectra cloneSpectra(const oefmt::FrameSpectra& s) {
+  oefmt::FrameSpectra copy = s;
+  copy.grey = s.grey.clone();
+  copy.spectrum = s.spectrum.clone();
+  copy.log_polar_spectrum = s.log_polar_spectrum.clone();
+  return copy;
+}
+
+// A reading belongs to a frame within this of its stamp [s].
+constexpr double kRangeMatch = 0.02;
+
+// The reading at `stamp` turned vertical with the camera's tilt (level without one); nothing
+// when there is none near the stamp or it had no return.
+std::optional<double> verticalRange(const std::vector<oefmt::RangeSample>& ranges, double stamp,
+                                    const std::optional<oefmt::CameraTilt>& tilt) {
+  const auto after = std::lower_bound(ranges.begin(), ranges.end(), stamp,
+                                      [](const oefmt::RangeSample& r, double t) { return r.stamp < t; });
+  const oefmt::RangeSample* nearest = nullptr;
+  for (auto it : {after, after == ranges.begin() ? ranges.end() : after - 1}) {
+    if (it != ranges.end() && (!nearest || std::fabs(it->stamp - stamp) < std::fabs(nearest->stamp - stamp))) {
+      nearest = &*it;
+    }
+  }
+  if (!nearest || std::fabs(nearest->stamp - stamp) > kRangeMatch || !std::isfinite(nearest->range)) return std::nullopt;
+  const double cosine = tilt ? std::cos(tilt->roll) * std::cos(tilt->pitch) : 1.0;
+  return nearest->range * cosine;
 }
 
 void writeDiagnosticsHeader(std::ostream& out) {
@@ -210,6 +253,17 @@ int main(int argc, char** argv) {
       }
     }
     auto unlevelled = std::make_shared<std::atomic<long>>(0);
+    // A downward rangefinder (a folder's range.txt, one reading per frame): the initial altitude
+    // when none is given, and the altitude above the reference plane all along (oefmt::RangeGate
+    // tells those readings from roofs'), which keeps the scale metric.
+    std::vector<oefmt::RangeSample> ranges;
+    const std::string range_path = options.images.empty() ? "" : options.images + "/" + oefmt::kRangeFileName;
+    if (options.use_range && !range_path.empty() && std::filesystem::exists(range_path)) {
+      ranges = oefmt::readRangeFile(range_path);
+      if (!options.quiet) std::fprintf(stderr, "oefmt_offline: altitude from %s\n", range_path.c_str());
+    }
+    oefmt::RangeGate range_gate;
+    oefmt::Pose4 last_range_pose;  // where the altitude was last measured
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
     // one registers the previous frame. Two frames queued let the reader run ahead over a slow
     // frame (one was slower; a second reader thread gained nothing more and cost memory, see
@@ -239,7 +293,8 @@ int main(int argc, char** argv) {
     trajectory.open(options.output);
     if (!trajectory) throw oefmt::InputError("cannot write '" + options.output + "'");
     trajectory << "# oefmt_offline " << oefmt::toString(config.mode) << ": t x y z qx qy qz qw ("
-               << (config.initial_altitude > 0.0 ? "metres" : "units of the initial altitude") << ")\n";
+               << (config.initial_altitude > 0.0 || !ranges.empty() ? "metres" : "units of the initial altitude")
+               << ")\n";
     if (!options.diagnostics.empty()) {
       diagnostics.open(options.diagnostics);
       if (!diagnostics) throw oefmt::InputError("cannot write '" + options.diagnostics + "'");
@@ -257,12 +312,56 @@ int main(int argc, char** argv) {
                              ? std::min<size_t>(source.source().size(), options.max_frames)
                              : source.source().size();
     oefmt::tools::ProgressBar progress("oefmt_offline", total, options.quiet ? nullptr : stderr);
+    // With a rangefinder and no altitude given, the first frames are run once ahead, in the units
+    // of the first reading, to find which of the layers in view the readings saw (rangeScale): the
+    // initial altitude is then the reference plane's metric depth.
+    std::deque<oefmt::SourceFrame> replay;
+    if (!ranges.empty() && !(options.altitude > 0.0)) {
+      oefmt::SourceFrame ahead;
+      std::unique_ptr<oefmt::Estimator> provisional;
+      std::vector<oefmt::RangeObservation> observations;
+      while (replay.size() < kScaleFrames && source.next(ahead)) {
+        const std::optional<double> vertical = verticalRange(ranges, ahead.stamp, ahead.tilt);
+        if (!provisional) {
+          if (!vertical) break;  // the first frame has no reading: the first reading decides
+          oefmt::EstimatorConfig provisional_config = config;
+          provisional_config.initial_altitude = *vertical;
+          provisional = std::make_unique<oefmt::Estimator>(provisional_config, context);
+        }
+        oefmt::SourceFrame copy = ahead;
+        copy.spectra = cloneSpectra(ahead.spectra);
+        replay.push_back(std::move(ahead));
+        const std::optional<oefmt::Estimate> e = provisional->push(std::move(copy.spectra), copy.stamp);
+        if (!e || !vertical) continue;
+        observations.push_back({*vertical, provisional->altitude(),
+                                oefmt::depthRatios(e->registration12.translation_energy, provisional->shiftPerBin(),
+                                                   e->step.shift())});
+      }
+      if (provisional) {
+        const double first = provisional->config().initial_altitude;
+        if (const std::optional<double> factor = oefmt::rangeScale(observations)) {
+          config.initial_altitude = *factor * first;
+        } else {
+          config.initial_altitude = first;
+        }
+      }
+    }
     oefmt::SourceFrame frame;
-    while ((options.max_frames < 0 || frames < options.max_frames) && source.next(frame)) {
+    const auto nextFrame = [&]() {
+      if (replay.empty()) return source.next(frame);
+      frame = std::move(replay.front());
+      replay.pop_front();
+      return true;
+    };
+    while ((options.max_frames < 0 || frames < options.max_frames) && nextFrame()) {
       if (!estimator) {
         if (!undistorter && !options.quiet) {
           std::fprintf(stderr, "oefmt_offline: no intrinsics (no cam_param.yaml/CameraInfo, no "
                                "--fx, no camera_fx): assuming a 53 degree field of view\n");
+        }
+        if (!ranges.empty() && !(config.initial_altitude > 0.0)) {
+          const std::optional<double> first = verticalRange(ranges, frame.stamp, frame.tilt);
+          if (first) config.initial_altitude = *first;
         }
         estimator = std::make_unique<oefmt::Estimator>(config, context);
         const std::string upscaling = oefmt::upscalingWarning(frame.image_size, config.registration.size);
@@ -290,12 +389,28 @@ int main(int argc, char** argv) {
       }
       if (estimate->state == oefmt::TrackingState::kRestarted) ++restarts;
       if (estimate->loop.status == oefmt::OptimizerStatus::kFallback) ++fallbacks;
+      if (!ranges.empty() && config.initial_altitude > 0.0 && estimate->state == oefmt::TrackingState::kTracking) {
+        const std::optional<double> vertical = verticalRange(ranges, frame.stamp, frame.tilt);
+        const std::vector<double> layers = oefmt::depthRatios(estimate->registration12.translation_energy,
+                                                              estimator->shiftPerBin(), estimate->step.shift());
+        if (const std::optional<double> altitude =
+                vertical ? range_gate.measure(*vertical, estimator->altitude(), layers) : std::nullopt) {
+          const double step = std::hypot(estimate->pose.x - last_range_pose.x, estimate->pose.y - last_range_pose.y);
+          estimator->observeAltitude(*altitude, kRangeSigma, std::pow(step * kAttitudeSigma, 2));
+          last_range_pose = estimator->pose();
+          estimate->pose = estimator->pose();
+        }
+      }
       trajectory << (frame.tilt ? oefmt::toTumLine(estimate->pose, *frame.tilt) : oefmt::toTumLine(estimate->pose))
                  << '\n';
       if (diagnostics.is_open()) writeDiagnosticsLine(diagnostics, *estimate);
       progress.update(static_cast<size_t>(frames));
     }
     progress.finish();
+    if (!ranges.empty() && !options.quiet) {
+      std::fprintf(stderr, "oefmt_offline: scale from the rangefinder: %ld readings taken, %ld refused\n",
+                   range_gate.accepted(), range_gate.refused());
+    }
     if (*unlevelled > 0) {
       std::fprintf(stderr,
                    "oefmt_offline: warning: %ld frames had no IMU attitude within 0.1 s of their stamp and were "

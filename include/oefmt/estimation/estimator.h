@@ -132,6 +132,16 @@ class Estimator {
   /// Forgets every frame; the next frame is the new origin.
   void reset();
 
+  /// An altitude measurement for the latest frame (a rangefinder's, above the reference plane, in
+  /// output units) with its standard deviation: the pose's z, and so the scale of every later
+  /// step, moves toward it (see PoseIntegrator::correctAltitude). `drift_variance` is added to
+  /// z's variance first: what the images' zoom cannot see of the altitude's change since the last
+  /// measurement (a camera tilted by an unknown angle reads part of its horizontal motion as
+  /// climb or descent).
+  void observeAltitude(double altitude, double sigma, double drift_variance = 0.0);
+  /// The altitude above the reference plane now (output units).
+  double altitude() const;
+
   /// Copy pair 1-2's correlation surfaces into every Estimate (costs copies; for debug views).
   void setKeepSurfaces(bool keep) { keep_surfaces_ = keep; }
 

@@ -59,6 +59,9 @@ class PoseIntegrator {
   const Pose4& integrate(const PairMotion& step, double stamp);
   /// Keeps the pose (no usable motion for this frame) and adds `extra_covariance`.
   const Pose4& hold(double stamp, const cv::Matx44d& extra_covariance);
+  /// A measurement of the altitude above the reference plane (output units) with its variance:
+  /// z moves toward it by the Kalman gain of z's own variance, which shrinks accordingly.
+  void correctAltitude(double altitude, double variance);
   /// Goes back to an earlier pose (e.g. undoing predictions once the real motion is known).
   void restore(const Pose4& pose) { pose_ = pose; }
   /// The covariance the last integrate() or hold() added to the pose (x, y, z, yaw): the

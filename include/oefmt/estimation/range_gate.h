@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Downward rangefinder readings turned into altitudes above the estimator's reference plane.
+//
+// A rangefinder reads the distance to whatever is below: the ground, or a roof when the vehicle
+// passes over one. The estimator's altitude is above one plane, the one whose shift its steps
+// follow. The translation energy vector of the newest pair holds a peak for every depth layer in
+// view, at a shift inversely proportional to the layer's depth; so a reading of layer l's surface
+// R, over the depth ratio c_l = (followed shift) / (layer l's shift), is the reference plane's
+// depth. A reading is taken when R / (predicted altitude) is within a gate of one of those
+// ratios (1 for the reference plane itself). When the readings keep disagreeing, but
+// consistently with each other, the estimate has drifted beyond the gate: the gate then opens to
+// them again, as readings of the reference plane.
+#pragma once
+
+#include <deque>
+#include <optional>
+#include <vector>
+
+namespace oefmt {
+
+class RangeGate {
+ public:
+  /// gate: largest relative difference of a reading from the prediction that is taken;
+  /// relock_after: this many consecutive readings refused, all within `gate` of their median,
+  /// are taken again.
+  explicit RangeGate(double gate = 0.08, int relock_after = 15);
+
+  /// `vertical`: the reading turned vertical (range times the cosine of the tilt) [m];
+  /// `predicted`: the estimator's altitude [m]; `depth_ratios`: the layers' c_l (depthRatios()).
+  /// The altitude above the reference plane the reading measures, or nothing.
+  std::optional<double> measure(double vertical, double predicted, const std::vector<double>& depth_ratios = {});
+
+  long accepted() const { return accepted_; }
+  long refused() const { return refused_; }
+
+ private:
+  double gate_;
+  int relock_after_;
+  std::deque<double> recent_ratios_;  // of consecutive refused readings
+  long accepted_ = 0;
+  long refused_ = 0;
+};
+
+/// One rangefinder reading beside the estimator's altitude and layers at its frame.
+struct RangeObservation {
+  double vertical = 0.0;              ///< the reading turned vertical [m]
+  double predicted = 0.0;             ///< the estimator's altitude then (any consistent unit)
+  std::vector<double> depth_ratios;   ///< depthRatios() of that frame
+};
+
+/// The factor that turns the estimator's altitudes into the reference plane's metric depth, from
+/// the first frames' readings, whichever layer each read: every reading proposes one factor per
+/// layer (vertical / (c_l predicted)), and the factor most readings fit (within `gate`, through
+/// some layer of theirs) wins; ties (readings that always saw the same layers) go to the smaller
+/// factor: the readings saw the farthest layer, the ground, which is most often below. Nothing
+/// unless at least `min_support` readings fit it.
+std::optional<double> rangeScale(const std::vector<RangeObservation>& observations, double gate = 0.08,
+                                 int min_support = 3);
+
+/// The depth ratios c_l = followed_shift / (shift of layer l) of the layers in a translation
+/// energy vector (bin j <-> shift j * shift_per_bin): its local maxima of at least a quarter of its
+/// highest, each refined by a parabola through its neighbours. Empty without an energy vector.
+std::vector<double> depthRatios(const std::vector<float>& translation_energy, double shift_per_bin,
+                                double followed_shift);
+
+}  // namespace oefmt

@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Attitude-aided registration: the camera's tilt read from its orientation, interpolation of an
+// IMU's orientations between samples, and the claim it rests on: a pure roll or pitch between
+// two frames over flat ground, once both frames are turned into the level view, registers as no
+// translation (while the raw frames register as tens of pixels of it).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "oefmt/estimation/attitude.h"
+#include "oefmt/io/nadir_view.h"
+#include "oefmt/registration/registration.h"
+#include "oefmt/sim/flight.h"
+#include "oefmt/sim/renderer.h"
+#include "support/fixtures.h"
+
+namespace oefmt {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+Eigen::Matrix3d opticalOf(const Eigen::Quaterniond& body) {
+  return body.toRotationMatrix() * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+}
+
+TEST(Attitude, TiltComesBackFromTheOrientationWhateverTheYaw) {
+  for (const double yaw : {0.0, 1.0, -2.5, 3.0}) {
+    for (const CameraTilt tilt : {CameraTilt{0.0, 0.0}, CameraTilt{0.1, -0.2}, CameraTilt{-0.3, 0.05}}) {
+      const CameraTilt back = cameraTilt(opticalOf(cameraBodyOrientation(yaw, tilt)));
+      EXPECT_NEAR(back.roll, tilt.roll, 1e-12);
+      EXPECT_NEAR(back.pitch, tilt.pitch, 1e-12);
+    }
+  }
+  // Level: the nadir rotation is the identity.
+  EXPECT_TRUE(nadirFromOptical(CameraTilt{}).isApprox(Eigen::Matrix3d::Identity(), 1e-15));
+  // The nadir rotation takes the tilted optical axis to the level one: straight down.
+  const double yaw = 0.7;
+  const CameraTilt tilt{0.2, -0.1};
+  const Eigen::Matrix3d optical = opticalOf(cameraBodyOrientation(yaw, tilt));
+  const Eigen::Matrix3d virtual_optical = optical * nadirFromOptical(tilt).transpose();
+  EXPECT_TRUE(virtual_optical.col(2).isApprox(Eigen::Vector3d(0.0, 0.0, -1.0), 1e-12));
+}
+
+TEST(Attitude, HistoryInterpolatesBetweenSamplesAndNotAcrossGaps) {
+  AttitudeHistory history(0.1);
+  const Eigen::Quaterniond a(Eigen::AngleAxisd(0.0, Eigen::Vector3d::UnitX()));
+  const Eigen::Quaterniond b(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()));
+  EXPECT_TRUE(history.add(1.0, a));
+  EXPECT_TRUE(history.add(1.05, b));
+  EXPECT_FALSE(history.add(1.05, a));  // not after the newest
+  EXPECT_TRUE(history.add(1.5, a));    // after a gap
+  const auto middle = history.at(1.025);
+  ASSERT_TRUE(middle.has_value());
+  EXPECT_NEAR(Eigen::AngleAxisd(*middle).angle(), 0.05, 1e-12);
+  EXPECT_TRUE(history.at(1.05).has_value());
+  EXPECT_FALSE(history.at(0.99).has_value());  // before the first
+  EXPECT_FALSE(history.at(1.3).has_value());   // in the gap
+  EXPECT_FALSE(history.at(1.6).has_value());   // after the newest
+  history.forgetBefore(1.5);
+  EXPECT_TRUE(history.at(1.5).has_value());
+}
+
+TEST(AttitudeAidedRegistration, PureRollOrPitchRegistersAsNoTranslation) {
+  constexpr int kN = 256;
+  sim::FlightOptions options;
+  options.width = options.height = kN;
+  options.flat = true;
+  options.track.frames = 2;
+  options.track.length = 1.0;
+  options.track.altitude = 20.0;
+  options.seed = 3;
+  const sim::FlightPlan plan = sim::planFlight(options);
+  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
+  const sim::Renderer renderer(scene, plan.camera, 2);
+  const NadirView nadir(plan.camera, cv::Size(kN, kN), plan.camera.intrinsics.fx, kN);
+  Registrar registrar(test::sharedContext(kN));
+
+  sim::FlightPose level = plan.poses[0];
+  const cv::Mat1f level_view = nadir.apply(renderer.render(level).image, nadirFromOptical(CameraTilt{}));
+  const FrameSpectra reference = registrar.analyse(level_view);
+  for (const CameraTilt tilt : {CameraTilt{6.0 * kDeg, 0.0}, CameraTilt{0.0, -5.0 * kDeg}, CameraTilt{4.0 * kDeg, 3.0 * kDeg}}) {
+    sim::FlightPose tilted = level;
+    tilted.roll = tilt.roll;
+    tilted.pitch = tilt.pitch;
+    const cv::Mat1f raw = renderer.render(tilted).image;
+    const PairRegistration unaided = registrar.registerPair(reference, registrar.analyse(raw));
+    const PairRegistration aided =
+        registrar.registerPair(reference, registrar.analyse(nadir.apply(raw, nadirFromOptical(tilt))));
+    // Unaided, the tilt is seen as a shift of about f tan(tilt): 19-23 px here.
+    const double seen_as_shift = plan.camera.intrinsics.fx * std::tan(std::hypot(tilt.roll, tilt.pitch));
+    EXPECT_NEAR(cv::norm(unaided.translation), seen_as_shift, 0.15 * seen_as_shift) << tilt.roll << " " << tilt.pitch;
+    EXPECT_LT(cv::norm(aided.translation), 0.5) << tilt.roll << " " << tilt.pitch;
+    EXPECT_NEAR(aided.rotation, 0.0, 0.2 * kDeg);
+    EXPECT_NEAR(aided.zoom, 1.0, 0.003);
+  }
+}
+
+}  // namespace
+}  // namespace oefmt
