@@ -2,7 +2,7 @@
 # Flight simulator, dataset conversion and trajectory evaluation tools, and the bag I/O library.
 
 # oefmt_bag_io: image streams in ROS bags (rosbag, sensor_msgs); the only ROS part of the I/O.
-add_library(oefmt_bag_io src/ros/bag_io.cpp)
+add_library(oefmt_bag_io src/ros/bag_io.cpp src/ros/vehicle_messages.cpp)
 target_link_libraries(oefmt_bag_io PUBLIC oefmt_io ${catkin_LIBRARIES})
 target_include_directories(oefmt_bag_io SYSTEM PUBLIC ${catkin_INCLUDE_DIRS})
 install(TARGETS oefmt_bag_io

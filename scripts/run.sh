@@ -14,7 +14,7 @@ command="${1:-demo}"
 # Debian 12 packages (ROS 1 is packaged by Debian; no other source is used).
 packages=(
   build-essential cmake pkg-config catkin ros-base-dev libroscpp-dev libnodelet-dev
-  libcv-bridge-dev libimage-geometry-dev libimage-transport-dev libtf2-ros-dev libtf2-geometry-msgs-dev librosbag-dev
+  libcv-bridge-dev libimage-geometry-dev libimage-transport-dev libtf2-ros-dev libtf2-msgs-dev libtf2-geometry-msgs-dev librosbag-dev
   ros-nav-msgs ros-sensor-msgs ros-geometry-msgs ros-message-generation ros-message-runtime
   libdiagnostic-updater-dev libceres-dev libopencv-dev libeigen3-dev libfftw3-dev libspng-dev libdeflate-dev
   libcli11-dev zlib1g-dev libyaml-cpp-dev

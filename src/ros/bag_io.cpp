@@ -14,9 +14,11 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/distortion_models.h>
 #include <sensor_msgs/image_encodings.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "oefmt/error.h"
 #include "oefmt/io/image_encoding.h"
+#include "oefmt/ros/vehicle_messages.h"
 
 namespace oefmt {
 namespace {
@@ -422,6 +424,39 @@ void BagFlightWriter::write(const cv::Mat& image, double stamp) {
     throw BagError("cannot encode image for bag '" + state_->path + "': " + e.what());
   }
   ++written_;
+}
+
+void BagFlightWriter::writeImu(const ImuSample& sample) {
+  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
+  try {
+    state_->bag.write(options_.imu_topic, rosTime(sample.stamp), imuMessage(sample, options_.imu_frame));
+  } catch (const rosbag::BagException& e) {
+    throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
+  }
+}
+
+void BagFlightWriter::writeRange(const RangeSample& sample) {
+  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
+  try {
+    state_->bag.write(options_.range_topic, rosTime(sample.stamp), rangeMessage(sample, options_.range_frame));
+  } catch (const rosbag::BagException& e) {
+    throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
+  }
+}
+
+void BagFlightWriter::writeMounts(double stamp) {
+  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
+  tf2_msgs::TFMessage mounts;
+  const double half = std::sqrt(0.5);
+  mounts.transforms.push_back(staticTransform(options_.base_frame, options_.frame_id, stamp, 1.0, 0.0, 0.0, 0.0));
+  mounts.transforms.push_back(staticTransform(options_.base_frame, options_.imu_frame, stamp, 0.0, 0.0, 0.0, 1.0));
+  // +90 degrees about y: the rangefinder's x (its beam) along the body's -z.
+  mounts.transforms.push_back(staticTransform(options_.base_frame, options_.range_frame, stamp, 0.0, half, 0.0, half));
+  try {
+    state_->bag.write("/tf_static", rosTime(stamp), mounts);
+  } catch (const rosbag::BagException& e) {
+    throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
+  }
 }
 
 void BagFlightWriter::close() {

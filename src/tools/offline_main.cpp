@@ -34,12 +34,13 @@
 #include "oefmt/io/fft_wisdom.h"
 #include "oefmt/io/nadir_view.h"
 #include "oefmt/io/vehicle_data.h"
+#include "oefmt/ros/vehicle_messages.h"
 #include "oefmt/io/run_setup.h"
 
 namespace {
 
 struct Options {
-  std::string images, bag, image_topic, camera_info_topic, output, diagnostics, config;
+  std::string images, bag, image_topic, camera_info_topic, imu_topic, range_topic, output, diagnostics, config;
   std::optional<oefmt::EstimatorMode> mode;
   double altitude = -1.0;
   double fx = 0.0;
@@ -67,6 +68,13 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
       ->type_name("T");
   app.add_option("--camera-info-topic", o.camera_info_topic,
                  "CameraInfo topic (default: <image namespace>/camera_info if present;\n'-' ignores intrinsics)")
+      ->type_name("T");
+  app.add_option("--imu-topic", o.imu_topic,
+                 "sensor_msgs/Imu topic in the bag (its frame taken as the camera\nbody): levels the frames as a "
+                 "folder's imu.txt does")
+      ->type_name("T");
+  app.add_option("--range-topic", o.range_topic,
+                 "sensor_msgs/Range topic of a downward rangefinder in the bag: the\nscale, as a folder's range.txt")
       ->type_name("T");
   app.add_option("--output", o.output,
                  "trajectory, TUM 't x y z qx qy qz qw' (t: a folder's timestamps.txt\n"
@@ -230,38 +238,55 @@ int main(int argc, char** argv) {
         config.working_fx = undistorter->workingFx();
       }
     }
-    // Attitude-aided registration: a folder's imu.txt (its body frame is the camera body) gives
-    // each frame's roll and pitch, with which the frame is turned into a level camera's view.
+    // Attitude-aided registration: a folder's imu.txt or a bag's --imu-topic (its frame is taken
+    // as the camera body) gives each frame's roll and pitch, with which the frame is turned into a
+    // level camera's view.
+    std::vector<oefmt::ImuSample> imu_samples;
+    std::string imu_source;
+    if (options.use_imu && !options.images.empty() &&
+        std::filesystem::exists(options.images + "/" + oefmt::kImuFileName)) {
+      imu_source = options.images + "/" + oefmt::kImuFileName;
+      imu_samples = oefmt::readImuFile(imu_source);
+    } else if (options.use_imu && !options.bag.empty() && !options.imu_topic.empty()) {
+      imu_source = options.imu_topic;
+      imu_samples = oefmt::readImuTopic(options.bag, options.imu_topic);
+      if (imu_samples.empty()) {
+        std::fprintf(stderr, "oefmt_offline: warning: %s has no orientation: the frames are taken as level\n",
+                     imu_source.c_str());
+      }
+    }
     std::shared_ptr<oefmt::AttitudeHistory> attitudes;
     std::shared_ptr<const oefmt::NadirView> nadir;
-    const std::string imu_path = options.images.empty() ? "" : options.images + "/" + oefmt::kImuFileName;
-    if (options.use_imu && !imu_path.empty() && std::filesystem::exists(imu_path)) {
+    if (!imu_samples.empty()) {
       if (!undistorter) {
         std::fprintf(stderr, "oefmt_offline: warning: %s ignored: no intrinsics to level the frames with\n",
-                     imu_path.c_str());
+                     imu_source.c_str());
       } else {
         attitudes = std::make_shared<oefmt::AttitudeHistory>();
-        for (const oefmt::ImuSample& sample : oefmt::readImuFile(imu_path)) {
-          attitudes->add(sample.stamp, sample.orientation);
-        }
+        for (const oefmt::ImuSample& sample : imu_samples) attitudes->add(sample.stamp, sample.orientation);
         nadir = std::make_shared<const oefmt::NadirView>(undistorter->inputCamera(), image_size,
                                                           config.working_fx, config.registration.size);
         if (!options.quiet) {
           std::fprintf(stderr, "oefmt_offline: attitude from %s: frames levelled with its roll and pitch\n",
-                       imu_path.c_str());
+                       imu_source.c_str());
         }
       }
     }
     auto unlevelled = std::make_shared<std::atomic<long>>(0);
-    // A downward rangefinder (a folder's range.txt, one reading per frame): the initial altitude
+    // A downward rangefinder (a folder's range.txt or a bag's --range-topic): the initial altitude
     // when none is given, and the altitude above the reference plane all along (oefmt::RangeGate
     // tells those readings from roofs'), which keeps the scale metric.
     std::vector<oefmt::RangeSample> ranges;
-    const std::string range_path = options.images.empty() ? "" : options.images + "/" + oefmt::kRangeFileName;
-    if (options.use_range && !range_path.empty() && std::filesystem::exists(range_path)) {
-      ranges = oefmt::readRangeFile(range_path);
-      if (!options.quiet) std::fprintf(stderr, "oefmt_offline: altitude from %s\n", range_path.c_str());
+    std::string range_source;
+    if (options.use_range && !options.images.empty() &&
+        std::filesystem::exists(options.images + "/" + oefmt::kRangeFileName)) {
+      range_source = options.images + "/" + oefmt::kRangeFileName;
+      ranges = oefmt::readRangeFile(range_source);
+    } else if (options.use_range && !options.bag.empty() && !options.range_topic.empty()) {
+      range_source = options.range_topic;
+      ranges = oefmt::readRangeTopic(options.bag, options.range_topic);
     }
+    if (!ranges.empty() && !options.quiet) std::fprintf(stderr, "oefmt_offline: altitude from %s\n", range_source.c_str());
     oefmt::RangeGate range_gate;
     oefmt::Pose4 last_range_pose;  // where the altitude was last measured
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
@@ -391,12 +416,14 @@ int main(int argc, char** argv) {
       if (estimate->loop.status == oefmt::OptimizerStatus::kFallback) ++fallbacks;
       if (!ranges.empty() && config.initial_altitude > 0.0 && estimate->state == oefmt::TrackingState::kTracking) {
         const std::optional<double> vertical = verticalRange(ranges, frame.stamp, frame.tilt);
+        // What an unknown tilt may have hidden of the climb since the last measurement.
+        const double unseen = std::pow(std::hypot(estimate->pose.x - last_range_pose.x,
+                                                  estimate->pose.y - last_range_pose.y) * kAttitudeSigma, 2);
         const std::vector<double> layers = oefmt::depthRatios(estimate->registration12.translation_energy,
                                                               estimator->shiftPerBin(), estimate->step.shift());
         if (const std::optional<double> altitude =
                 vertical ? range_gate.measure(*vertical, estimator->altitude(), layers) : std::nullopt) {
-          const double step = std::hypot(estimate->pose.x - last_range_pose.x, estimate->pose.y - last_range_pose.y);
-          estimator->observeAltitude(*altitude, kRangeSigma, std::pow(step * kAttitudeSigma, 2));
+          estimator->observeAltitude(*altitude, kRangeSigma, unseen);
           last_range_pose = estimator->pose();
           estimate->pose = estimator->pose();
         }
@@ -407,9 +434,16 @@ int main(int argc, char** argv) {
       progress.update(static_cast<size_t>(frames));
     }
     progress.finish();
-    if (!ranges.empty() && !options.quiet) {
-      std::fprintf(stderr, "oefmt_offline: scale from the rangefinder: %ld readings taken, %ld refused\n",
-                   range_gate.accepted(), range_gate.refused());
+    if (!options.quiet) {
+      if (!ranges.empty()) {
+        std::fprintf(stderr, "oefmt_offline: scale from the rangefinder (%ld readings taken, %ld refused)\n",
+                     range_gate.accepted(), range_gate.refused());
+      } else if (config.initial_altitude > 0.0) {
+        std::fprintf(stderr, "oefmt_offline: scale from the initial altitude (%g m), kept by the images\n",
+                     config.initial_altitude);
+      } else {
+        std::fprintf(stderr, "oefmt_offline: no metric scale: units of the initial altitude\n");
+      }
     }
     if (*unlevelled > 0) {
       std::fprintf(stderr,

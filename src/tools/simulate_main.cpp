@@ -279,7 +279,9 @@ Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames,
   const std::string output = "time and output";
   addNumber(app, "--rate", f.rate, "HZ", "frame rate (default 5)")->group(output);
   addNumber(app, "--start-time", f.start_time, "S", "stamp of the first frame (default 1.0)")->group(output);
-  app.add_option("--bag", command.bag, "also write a ROS bag (sensor_msgs/Image + CameraInfo)")
+  app.add_option("--bag", command.bag,
+                 "also write a ROS bag (sensor_msgs/Image + CameraInfo; with --imu\nand --range also sensor_msgs/Imu on "
+                 "/imu/data, sensor_msgs/Range\non /rangefinder/range and their mounts on /tf_static)")
       ->type_name("FILE")
       ->group(output);
   addChoice(app, "--bag-compression", command.bag_options.compression, {"none", "lz4", "bz2"},
@@ -411,14 +413,22 @@ int main(int argc, char** argv) {
     folder.finish();
     const std::filesystem::path folder_path(command.output);
     if (command.imu) {
-      oefmt::writeImuFile((folder_path / oefmt::kImuFileName).string(), oefmt::sim::simulateFlightImu(plan),
+      const std::vector<oefmt::ImuSample> imu = oefmt::sim::simulateFlightImu(plan);
+      oefmt::writeImuFile((folder_path / oefmt::kImuFileName).string(), imu,
                           {"oefmt_simulate IMU (frame: base_link, the camera body): t qx qy qz qw wx wy wz ax ay az",
                            "orientation body to world (ENU); angular velocity [rad/s] and specific force [m/s^2] in the body frame"});
+      if (bag) {
+        for (const oefmt::ImuSample& sample : imu) bag->writeImu(sample);
+      }
     }
     if (command.range) {
       oefmt::writeRangeFile((folder_path / oefmt::kRangeFileName).string(), ranges,
                             {"oefmt_simulate rangefinder: t range [m] along the body's -z; inf: no return"});
+      if (bag) {
+        for (const oefmt::RangeSample& sample : ranges) bag->writeRange(sample);
+      }
     }
+    if (bag && (command.imu || command.range)) bag->writeMounts(plan.stamps.front());
     if (bag) bag->close();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!command.quiet) {

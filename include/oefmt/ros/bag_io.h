@@ -16,6 +16,7 @@
 #include <sensor_msgs/Image.h>
 
 #include "oefmt/io/dataset.h"
+#include "oefmt/io/vehicle_data.h"
 
 namespace oefmt {
 
@@ -100,6 +101,12 @@ struct BagWriterOptions {
   std::string compression = "none";  ///< bag chunk compression: none, lz4 or bz2
   /// Empty: raw sensor_msgs/Image. "png" or "jpg": sensor_msgs/CompressedImage in that format.
   std::string image_format;
+  std::string imu_topic = "/imu/data";
+  std::string range_topic = "/rangefinder/range";
+  /// Frames of the static transforms writeMounts() writes: the body, the IMU, the rangefinder.
+  std::string base_frame = "base_link";
+  std::string imu_frame = "imu_link";
+  std::string range_frame = "rangefinder";
 };
 
 /// Writes images and their CameraInfo (same stamp) to a new bag.
@@ -113,6 +120,13 @@ class BagFlightWriter {
 
   /// stamp > 0 [s]. Throws BagError for an unsupported image type or a write failure.
   void write(const cv::Mat& image, double stamp);
+  /// A sensor_msgs/Imu on imu_topic (frame imu_frame) and a sensor_msgs/Range on range_topic
+  /// (frame range_frame). Throws BagError for a write failure.
+  void writeImu(const ImuSample& sample);
+  void writeRange(const RangeSample& sample);
+  /// /tf_static at `stamp`: base -> camera (frame_id; looking down the body's -z, image right on
+  /// the body's x), base -> IMU (aligned), base -> rangefinder (its x axis down the body's -z).
+  void writeMounts(double stamp);
   /// Closes the bag (also done by the destructor). Throws BagError on failure.
   void close();
   std::size_t written() const { return written_; }
