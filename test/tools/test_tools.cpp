@@ -19,6 +19,7 @@
 #include "support/package_files.h"
 #include "support/temp_dir.h"
 #include "oefmt/io/dataset.h"
+#include "oefmt/io/tum.h"
 #include "oefmt/ros/bag_io.h"
 
 namespace oefmt {
@@ -425,6 +426,49 @@ TEST(Tools, OfflineRefusesTinyFrames) {
 
 // scripts/measure_speed.py: a line with the figures of each run, the summaries, and a clear
 // error when there is no oefmt_offline to run.
+// A tilting multirotor's flight (IMU and rangefinder written): levelled by the IMU, the frames
+// register as a level camera's, and the rangefinder makes the trajectory metric, from a folder
+// and from a bag alike; without them the tilt is read as motion.
+TEST(Tools, OfflineLevelsTiltedFramesWithTheImuAndScalesWithTheRangefinder) {
+  TempDir dir;
+  const ToolRun simulate =
+      run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 256 --track line --frames 40 --length 60 --seed 6 " +
+                   "--wobble 8 --wobble-hz 1 --imu --range --bag " + (dir / "flight.bag") + " " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  std::ofstream(dir / "size256.yaml") << "registration:\n   size: 256\n";
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --config " + (dir / "size256.yaml");
+  const ToolRun aided = run(dir, offline + " --images " + (dir / "flight") + " --output " + (dir / "aided.tum"));
+  ASSERT_EQ(aided.status, 0) << aided.err;
+  EXPECT_NE(aided.err.find("frames levelled with its roll and pitch"), std::string::npos) << aided.err;
+  EXPECT_NE(aided.err.find("scale from the rangefinder"), std::string::npos) << aided.err;
+  const ToolRun bag = run(dir, offline + " --bag " + (dir / "flight.bag") +
+                                   " --imu-topic /imu/data --range-topic /rangefinder/range --output " + (dir / "bag.tum"));
+  ASSERT_EQ(bag.status, 0) << bag.err;
+  // The same to within the text files' rounding (imu.txt keeps 9 digits of a quaternion).
+  EXPECT_LT(largestDifference(poses(dir / "aided.tum"), poses(dir / "bag.tum")), 1e-3);
+  const ToolRun unaided = run(dir, offline + " --no-imu --no-range --images " + (dir / "flight") + " --output " +
+                                       (dir / "unaided.tum"));
+  ASSERT_EQ(unaided.status, 0) << unaided.err;
+  // Metric without any alignment of scale (rigid), against the ground truth; and the tilt, read
+  // as motion without the IMU, costs many times that.
+  const auto ate = [&](const std::string& trajectory, const std::string& options) {
+    const ToolRun evaluate = run(dir, std::string(OEFMT_EVALUATE) + " --json-only " + options + " " + trajectory + " " +
+                                          (dir / "flight/groundtruth.tum"));
+    EXPECT_EQ(evaluate.status, 0) << evaluate.err;
+    const auto at = evaluate.out.find("\"rmse\":");
+    return at == std::string::npos ? 1e9 : std::stod(evaluate.out.substr(at + 7));
+  };
+  const double aided_rigid = ate(dir / "aided.tum", "--no-scale");
+  EXPECT_LT(aided_rigid, 0.3);
+  EXPECT_GT(ate(dir / "unaided.tum", ""), 5.0 * aided_rigid);
+  // The trajectory carries the IMU's roll and pitch: not level (the wobble is up to 8 degrees).
+  double largest_tilt = 0.0;
+  for (const StampedPose& pose : readTum(dir / "aided.tum")) {
+    largest_tilt = std::max({largest_tilt, std::fabs(pose.orientation.x()), std::fabs(pose.orientation.y())});
+  }
+  EXPECT_GT(largest_tilt, 0.02);
+}
+
 TEST(Tools, MeasureSpeedReportsEveryRun) {
   TempDir dir;
   ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));
