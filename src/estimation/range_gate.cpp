@@ -42,6 +42,22 @@ std::optional<double> RangeGate::measure(double vertical, double predicted, cons
   return std::nullopt;
 }
 
+RangeAltitude::RangeAltitude(double reading_sigma, double attitude_sigma)
+    : reading_sigma_(reading_sigma), attitude_sigma_(attitude_sigma) {}
+
+bool RangeAltitude::update(Estimator& estimator, const Estimate& estimate, std::optional<double> vertical) {
+  if (!vertical || estimate.state != TrackingState::kTracking) return false;
+  const std::vector<double> layers =
+      depthRatios(estimate.registration12.translation_energy, estimator.shiftPerBin(), estimate.step.shift());
+  const std::optional<double> altitude = gate_.measure(*vertical, estimator.altitude(), layers);
+  if (!altitude) return false;
+  const double unseen = std::hypot(estimate.pose.x - last_x_, estimate.pose.y - last_y_) * attitude_sigma_;
+  estimator.observeAltitude(*altitude, reading_sigma_, unseen * unseen);
+  last_x_ = estimator.pose().x;
+  last_y_ = estimator.pose().y;
+  return true;
+}
+
 std::optional<double> rangeScale(const std::vector<RangeObservation>& observations, double gate, int min_support) {
   const auto fits = [gate](const RangeObservation& o, double factor) {
     const double ratio = o.vertical / (factor * o.predicted);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/io/vehicle_data.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -67,6 +68,18 @@ void close(std::FILE* file, const std::string& path) {
 }
 
 }  // namespace
+
+std::optional<RangeSample> rangeAt(const std::vector<RangeSample>& readings, double stamp, double tolerance) {
+  const auto after = std::lower_bound(readings.begin(), readings.end(), stamp,
+                                      [](const RangeSample& r, double t) { return r.stamp < t; });
+  std::optional<RangeSample> nearest;
+  if (after != readings.end()) nearest = *after;
+  if (after != readings.begin() && (!nearest || stamp - (after - 1)->stamp < nearest->stamp - stamp)) {
+    nearest = *(after - 1);
+  }
+  if (!nearest || !(std::fabs(nearest->stamp - stamp) <= tolerance)) return std::nullopt;
+  return nearest;
+}
 
 std::vector<ImuSample> readImuFile(const std::string& path) {
   std::vector<ImuSample> samples;

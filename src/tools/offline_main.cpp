@@ -119,11 +119,6 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
   return oefmt::tools::parseCommandLine(app, argc, argv);
 }
 
-// A rangefinder reading's standard deviation [m], for the altitude correction.
-constexpr double kRangeSigma = 0.05;
-// The camera's tilt is known to about this [rad] (a typical attitude filter's accuracy, or a level
-// mount's): a step of length L may then climb or descend L times it unseen by the images' zoom.
-constexpr double kAttitudeSigma = 0.5 * M_PI / 180.0;
 // Frames run ahead to find the rangefinder's scale.
 constexpr std::size_t kScaleFrames = 20;
 
@@ -143,17 +138,10 @@ constexpr double kRangeMatch = 0.02;
 // when there is none near the stamp or it had no return.
 std::optional<double> verticalRange(const std::vector<oefmt::RangeSample>& ranges, double stamp,
                                     const std::optional<oefmt::CameraTilt>& tilt) {
-  const auto after = std::lower_bound(ranges.begin(), ranges.end(), stamp,
-                                      [](const oefmt::RangeSample& r, double t) { return r.stamp < t; });
-  const oefmt::RangeSample* nearest = nullptr;
-  for (auto it : {after, after == ranges.begin() ? ranges.end() : after - 1}) {
-    if (it != ranges.end() && (!nearest || std::fabs(it->stamp - stamp) < std::fabs(nearest->stamp - stamp))) {
-      nearest = &*it;
-    }
-  }
-  if (!nearest || std::fabs(nearest->stamp - stamp) > kRangeMatch || !std::isfinite(nearest->range)) return std::nullopt;
+  const std::optional<oefmt::RangeSample> reading = oefmt::rangeAt(ranges, stamp, kRangeMatch);
+  if (!reading || !std::isfinite(reading->range)) return std::nullopt;
   const double cosine = tilt ? std::cos(tilt->roll) * std::cos(tilt->pitch) : 1.0;
-  return nearest->range * cosine;
+  return reading->range * cosine;
 }
 
 void writeDiagnosticsHeader(std::ostream& out) {
@@ -287,8 +275,7 @@ int main(int argc, char** argv) {
       ranges = oefmt::readRangeTopic(options.bag, options.range_topic);
     }
     if (!ranges.empty() && !options.quiet) std::fprintf(stderr, "oefmt_offline: altitude from %s\n", range_source.c_str());
-    oefmt::RangeGate range_gate;
-    oefmt::Pose4 last_range_pose;  // where the altitude was last measured
+    oefmt::RangeAltitude range_altitude;
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
     // one registers the previous frame. Two frames queued let the reader run ahead over a slow
     // frame (one was slower; a second reader thread gained nothing more and cost memory, see
@@ -414,19 +401,9 @@ int main(int argc, char** argv) {
       }
       if (estimate->state == oefmt::TrackingState::kRestarted) ++restarts;
       if (estimate->loop.status == oefmt::OptimizerStatus::kFallback) ++fallbacks;
-      if (!ranges.empty() && config.initial_altitude > 0.0 && estimate->state == oefmt::TrackingState::kTracking) {
-        const std::optional<double> vertical = verticalRange(ranges, frame.stamp, frame.tilt);
-        // What an unknown tilt may have hidden of the climb since the last measurement.
-        const double unseen = std::pow(std::hypot(estimate->pose.x - last_range_pose.x,
-                                                  estimate->pose.y - last_range_pose.y) * kAttitudeSigma, 2);
-        const std::vector<double> layers = oefmt::depthRatios(estimate->registration12.translation_energy,
-                                                              estimator->shiftPerBin(), estimate->step.shift());
-        if (const std::optional<double> altitude =
-                vertical ? range_gate.measure(*vertical, estimator->altitude(), layers) : std::nullopt) {
-          estimator->observeAltitude(*altitude, kRangeSigma, unseen);
-          last_range_pose = estimator->pose();
-          estimate->pose = estimator->pose();
-        }
+      if (!ranges.empty() && config.initial_altitude > 0.0 &&
+          range_altitude.update(*estimator, *estimate, verticalRange(ranges, frame.stamp, frame.tilt))) {
+        estimate->pose = estimator->pose();
       }
       trajectory << (frame.tilt ? oefmt::toTumLine(estimate->pose, *frame.tilt) : oefmt::toTumLine(estimate->pose))
                  << '\n';
@@ -437,7 +414,7 @@ int main(int argc, char** argv) {
     if (!options.quiet) {
       if (!ranges.empty()) {
         std::fprintf(stderr, "oefmt_offline: scale from the rangefinder (%ld readings taken, %ld refused)\n",
-                     range_gate.accepted(), range_gate.refused());
+                     range_altitude.gate().accepted(), range_altitude.gate().refused());
       } else if (config.initial_altitude > 0.0) {
         std::fprintf(stderr, "oefmt_offline: scale from the initial altitude (%g m), kept by the images\n",
                      config.initial_altitude);

@@ -16,6 +16,8 @@
 #include <optional>
 #include <vector>
 
+#include "oefmt/estimation/estimator.h"
+
 namespace oefmt {
 
 class RangeGate {
@@ -39,6 +41,28 @@ class RangeGate {
   std::deque<double> recent_ratios_;  // of consecutive refused readings
   long accepted_ = 0;
   long refused_ = 0;
+};
+
+/// Keeps an estimator's altitude, and with it the scale, metric with a downward rangefinder: each
+/// tracked frame's reading (turned vertical), taken by a RangeGate through the frame's depth
+/// layers, corrects the altitude (Estimator::observeAltitude).
+class RangeAltitude {
+ public:
+  /// reading_sigma: the rangefinder's noise [m]; attitude_sigma: how well the camera's tilt is
+  /// known [rad] (a step of length L may climb or descend L times it unseen by the images' zoom).
+  explicit RangeAltitude(double reading_sigma = 0.05, double attitude_sigma = 0.5 * M_PI / 180.0);
+
+  /// After `estimator` gave `estimate` for a frame: its reading (nothing without one). True when
+  /// the reading corrected the altitude; the estimator's pose() is then the corrected one.
+  bool update(Estimator& estimator, const Estimate& estimate, std::optional<double> vertical);
+
+  const RangeGate& gate() const { return gate_; }
+
+ private:
+  RangeGate gate_;
+  double reading_sigma_;
+  double attitude_sigma_;
+  double last_x_ = 0.0, last_y_ = 0.0;  // where the altitude was last measured
 };
 
 /// One rangefinder reading beside the estimator's altitude and layers at its frame.

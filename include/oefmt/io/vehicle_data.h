@@ -11,6 +11,7 @@
 //              (out of range or a dropout, as REP-117 has it)
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,9 @@ struct RangeSample {
   double stamp = 0.0;  ///< [s]
   double range = 0.0;  ///< [m]; +inf: no return
 };
+
+/// The reading nearest `stamp` if within `tolerance` [s] of it (any value, +inf included).
+std::optional<RangeSample> rangeAt(const std::vector<RangeSample>& readings, double stamp, double tolerance);
 
 /// The file names inside a dataset folder.
 constexpr const char* kImuFileName = "imu.txt";
