@@ -39,6 +39,15 @@ Eigen::Quaterniond cameraBodyOrientation(double yaw, const CameraTilt& tilt) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * tiltRotation(tilt)).normalized();
 }
 
+Eigen::Matrix3d downLookingMount() { return flipX(); }
+
+std::optional<CameraTilt> cameraTiltAt(const AttitudeHistory& body, double stamp,
+                                       const Eigen::Matrix3d& body_from_optical) {
+  const std::optional<Eigen::Quaterniond> orientation = body.at(stamp);
+  if (!orientation) return std::nullopt;
+  return cameraTilt(orientation->toRotationMatrix() * body_from_optical);
+}
+
 AttitudeHistory::AttitudeHistory(double max_gap) : max_gap_(max_gap) {}
 
 bool AttitudeHistory::add(double stamp, const Eigen::Quaterniond& body_to_world) {

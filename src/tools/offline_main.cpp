@@ -290,10 +290,9 @@ int main(int argc, char** argv) {
         [builder = oefmt::SpectraBuilder(context), undistorter, attitudes, nadir,
          unlevelled](oefmt::SourceFrame& frame) mutable {
           if (attitudes) {
-            if (const std::optional<Eigen::Quaterniond> body = attitudes->at(frame.stamp)) {
-              // The IMU's body is the camera body: the optical frame is it turned about x.
-              const Eigen::Matrix3d optical = body->toRotationMatrix() * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
-              frame.tilt = oefmt::cameraTilt(optical);
+            // The IMU's body is the camera body: the optical frame is it turned about x.
+            frame.tilt = oefmt::cameraTiltAt(*attitudes, frame.stamp);
+            if (frame.tilt) {
               frame.spectra = builder.build(nadir->apply(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
               return;
             }

@@ -20,9 +20,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-Eigen::Matrix3d opticalOf(const Eigen::Quaterniond& body) {
-  return body.toRotationMatrix() * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
-}
+Eigen::Matrix3d opticalOf(const Eigen::Quaterniond& body) { return body.toRotationMatrix() * downLookingMount(); }
 
 TEST(Attitude, TiltComesBackFromTheOrientationWhateverTheYaw) {
   for (const double yaw : {0.0, 1.0, -2.5, 3.0}) {
@@ -59,6 +57,15 @@ TEST(Attitude, HistoryInterpolatesBetweenSamplesAndNotAcrossGaps) {
   EXPECT_FALSE(history.at(1.6).has_value());   // after the newest
   history.forgetBefore(1.5);
   EXPECT_TRUE(history.at(1.5).has_value());
+  // A camera's tilt from the body's orientation and the camera's mount: a mount turned 10 degrees
+  // about the body's y adds 10 degrees of pitch.
+  AttitudeHistory level;
+  level.add(0.0, Eigen::Quaterniond::Identity());
+  level.add(0.05, Eigen::Quaterniond::Identity());
+  EXPECT_NEAR(cameraTiltAt(level, 0.02)->pitch, 0.0, 1e-12);
+  const Eigen::Matrix3d mount = Eigen::AngleAxisd(0.1745, Eigen::Vector3d::UnitY()).toRotationMatrix() * downLookingMount();
+  EXPECT_NEAR(cameraTiltAt(level, 0.02, mount)->pitch, 0.1745, 1e-9);
+  EXPECT_FALSE(cameraTiltAt(level, 0.2).has_value());
 }
 
 TEST(AttitudeAidedRegistration, PureRollOrPitchRegistersAsNoTranslation) {

@@ -32,6 +32,16 @@ Eigen::Matrix3d nadirFromOptical(const CameraTilt& tilt);
 /// The camera body's orientation (body to world) of a yaw and a tilt.
 Eigen::Quaterniond cameraBodyOrientation(double yaw, const CameraTilt& tilt);
 
+/// The camera body (x image right, y image up, z against the view) of a camera looking straight
+/// down the body's -z axis: the optical frame's orientation in the body for cameraTiltAt.
+Eigen::Matrix3d downLookingMount();
+
+class AttitudeHistory;
+/// The tilt at `stamp` of a camera mounted on the body at `body_from_optical`, from the body's
+/// orientations; nothing when the history has none at that stamp.
+std::optional<CameraTilt> cameraTiltAt(const AttitudeHistory& body, double stamp,
+                                       const Eigen::Matrix3d& body_from_optical = downLookingMount());
+
 /// Orientations of a body (body to world) over time, as an IMU or attitude filter gives them,
 /// read at any stamp between two of them by spherical interpolation.
 class AttitudeHistory {
