@@ -37,6 +37,17 @@ ParameterTable nodeParameters(RosParameters& p) {
       booleanParameter("use_altitude_topic", p.use_altitude_topic,
                        "take the initial altitude from the first valid range on the altitude topic "
                        "(sensor_msgs/Range; the odometry waits for it), over initial_altitude"),
+      booleanParameter("use_imu", p.use_imu,
+                       "level every frame with the roll and pitch of the imu topic (sensor_msgs/Imu with "
+                       "an orientation; its frame taken as base_frame) whenever it publishes"),
+      numberParameter("imu_timeout", p.imu_timeout, "s", above(0.0),
+                      "an IMU orientation further than this from a frame's stamp is stale: the frame is "
+                      "taken as level, with a warning"),
+      booleanParameter("use_range", p.use_range,
+                       "keep the scale metric with every valid range of the altitude topic (a downward "
+                       "rangefinder, sensor_msgs/Range): the first 20 frames' readings settle which depth "
+                       "layer they saw, later ones correct the altitude; experimental in the node (on a "
+                       "short tilted replay it made the error worse, oefmt_offline's look-ahead does not)"),
       numberParameter("time_jump_tolerance", p.time_jump_tolerance, "s", above(0.0),
                       "a stamp this far behind the last one restarts the odometry; less is a dropped "
                       "reordering"),

@@ -19,6 +19,7 @@
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/ros/bag_io.h"
 #include "oefmt/ros/estimate_messages.h"
+#include "oefmt/ros/vehicle_messages.h"
 #include "oefmt/ros/parameter_server.h"
 #include "oefmt/estimation/pose.h"
 #include "oefmt/io/undistortion.h"
@@ -76,8 +77,12 @@ OdometryRos::OdometryRos(ros::NodeHandle nh, ros::NodeHandle private_nh, const s
 
   camera_info_subscriber_ =
       nh_.subscribe("camera_info", parameters_.queue_size, &OdometryRos::cameraInfoCallback, this);
-  if (parameters_.use_altitude_topic) {
-    altitude_subscriber_ = nh_.subscribe("altitude", 5, &OdometryRos::altitudeCallback, this);
+  if (parameters_.use_altitude_topic || parameters_.use_range) {
+    altitude_subscriber_ = nh_.subscribe("altitude", 20, &OdometryRos::altitudeCallback, this);
+  }
+  if (parameters_.use_imu) {
+    attitudes_ = AttitudeHistory(parameters_.imu_timeout);
+    imu_subscriber_ = nh_.subscribe("imu", 400, &OdometryRos::imuCallback, this);
   }
   queue_.setCapacity(static_cast<std::size_t>(parameters_.input_buffer));
   worker_ = std::thread(&OdometryRos::workerLoop, this);
@@ -161,10 +166,69 @@ void OdometryRos::cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& mess
 void OdometryRos::altitudeCallback(const sensor_msgs::RangeConstPtr& message) {
   if (!std::isfinite(message->range) || message->range < message->min_range ||
       message->range > message->max_range) {
+    return;  // no return (REP-117's +inf), too close, or invalid
+  }
+  {
+    std::lock_guard<std::mutex> lock(vehicle_mutex_);
+    ranges_.push_back({message->header.stamp.toSec(), message->range});
+    constexpr std::size_t kKeptReadings = 50;
+    if (ranges_.size() > kKeptReadings) ranges_.pop_front();
+  }
+  {
+    std::lock_guard<std::mutex> lock(camera_mutex_);
+    altitude_from_topic_ = message->range;
+  }
+  camera_ready_.notify_all();
+}
+
+void OdometryRos::imuCallback(const sensor_msgs::ImuConstPtr& message) {
+  if (!hasOrientation(*message)) {
+    ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": " << nh_.resolveName("imu")
+                                                << " has no orientation: frames are taken as level");
     return;
   }
-  std::lock_guard<std::mutex> lock(camera_mutex_);
-  altitude_from_topic_ = message->range;
+  const ImuSample sample = imuSample(*message);
+  std::lock_guard<std::mutex> lock(vehicle_mutex_);
+  attitudes_.add(sample.stamp, sample.orientation);
+  attitudes_.forgetBefore(sample.stamp - 10.0);  // frames older than that are long processed
+  const double roll = message->orientation_covariance[0], pitch = message->orientation_covariance[4];
+  imu_orientation_variance_ = std::isfinite(roll) && std::isfinite(pitch) ? std::max({roll, pitch, 0.0}) : 0.0;
+}
+
+std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
+  std::optional<Eigen::Quaterniond> body;
+  {
+    std::lock_guard<std::mutex> lock(vehicle_mutex_);
+    if (attitudes_.empty()) return std::nullopt;
+    const double stamp = frame.stamp.toSec();
+    body = attitudes_.at(stamp);
+    // The newest orientation may lag the image by less than a sample: taken when recent enough.
+    if (!body && stamp >= attitudes_.newestStamp() && stamp - attitudes_.newestStamp() <= parameters_.imu_timeout) {
+      body = attitudes_.at(attitudes_.newestStamp());
+    }
+  }
+  if (!body) {
+    ++unlevelled_;
+    ROS_WARN_STREAM_THROTTLE(kWarnPeriod, name_ << ": no IMU orientation within " << parameters_.imu_timeout
+                                                << " s of the frame: taken as level (" << unlevelled_
+                                                << " frames so far)");
+    body_tilt_.reset();
+    return std::nullopt;
+  }
+  // The IMU's frame is taken as base_frame: its own roll and pitch, and the camera's by the mount.
+  body_tilt_ = cameraTilt(body->toRotationMatrix() * downLookingMount());
+  return cameraTilt(body->toRotationMatrix() * mount_);
+}
+
+std::optional<double> OdometryRos::verticalRangeAt(const InputFrame& frame, const std::optional<CameraTilt>& tilt) {
+  constexpr double kRangeMatch = 0.05;  // [s]: a reading belongs to a frame this near
+  std::optional<RangeSample> reading;
+  {
+    std::lock_guard<std::mutex> lock(vehicle_mutex_);
+    reading = rangeAt(std::vector<RangeSample>(ranges_.begin(), ranges_.end()), frame.stamp.toSec(), kRangeMatch);
+  }
+  if (!reading) return std::nullopt;
+  return reading->range * (tilt ? std::cos(tilt->roll) * std::cos(tilt->pitch) : 1.0);
 }
 
 bool OdometryRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -198,6 +262,11 @@ void OdometryRos::resetEstimator(const std::string& why) {
   path_.poses.clear();
   previous_pose_.reset();
   input_size_ = cv::Size();
+  nadir_.reset();
+  range_altitude_ = RangeAltitude();
+  scale_votes_.clear();
+  scale_frames_ = 0;
+  scale_settled_ = false;
 }
 
 cv::Mat OdometryRos::decode(const InputFrame& frame) {
@@ -226,6 +295,11 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
       camera_ready_.wait_for(lock, std::chrono::seconds(1), [this] { return camera_info_ != nullptr; });
     }
     info = camera_info_;
+    // A rangefinder that publishes gives the initial altitude: its first reading may trail the
+    // first image by a moment.
+    if (!estimator_ && parameters_.use_range && !altitude_from_topic_ && altitude_subscriber_.getNumPublishers() > 0) {
+      camera_ready_.wait_for(lock, std::chrono::milliseconds(500), [this] { return altitude_from_topic_.has_value(); });
+    }
     altitude_topic = altitude_from_topic_;
   }
   // The camera of the frames as registered (set up as oefmt_offline does): camera_info's
@@ -273,6 +347,10 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     config.initial_altitude = chooseInitialAltitude(altitude_topic, config.initial_altitude);
     estimator_ = std::make_unique<Estimator>(config);
     lookUpCameraMount(frame);
+    if (parameters_.use_imu) {
+      nadir_ = std::make_unique<const NadirView>(undistorter_->inputCamera(), image.size(), working_fx,
+                                                 config.registration.size);
+    }
     estimator_fx_ = working_fx;
     input_size_ = image.size();
     ROS_INFO_STREAM(name_ << ": odometry started at " << frame.stamp << " (" << image.cols << "x"
@@ -286,6 +364,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
 
 void OdometryRos::lookUpCameraMount(const InputFrame& frame) {
   mount_yaw_ = 0.0;
+  mount_ = downLookingMount();
   const std::string camera_frame =
       parameters_.camera_frame.empty() ? frame.frame_id : parameters_.camera_frame;
   if (camera_frame.empty()) return;
@@ -301,6 +380,7 @@ void OdometryRos::lookUpCameraMount(const InputFrame& frame) {
     return;
   }
   const auto& q = mount.transform.rotation;
+  mount_ = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
   const tf2::Matrix3x3 optical(tf2::Quaternion(q.x, q.y, q.z, q.w));
   // Camera body = optical frame with y and z flipped (x image right, y image up, z up).
   const tf2::Matrix3x3 body = optical * tf2::Matrix3x3(1, 0, 0, 0, -1, 0, 0, 0, -1);
@@ -332,7 +412,14 @@ void OdometryRos::process(const InputFrame& frame) {
     ++frames_rejected_;
     return;
   }
-  if (undistorter_) image = rectifyToWorkingFrame(*undistorter_, working_camera_, image);
+  // A tilted frame becomes a level camera's view (lens undone in the same step); else the
+  // rectification of the working frame.
+  const std::optional<CameraTilt> tilt = parameters_.use_imu ? tiltAt(frame) : std::nullopt;
+  if (tilt && nadir_) {
+    image = nadir_->apply(image, nadirFromOptical(*tilt));
+  } else if (undistorter_) {
+    image = rectifyToWorkingFrame(*undistorter_, working_camera_, image);
+  }
   // Correlation surfaces cost copies: only while someone watches them.
   estimator_->setKeepSurfaces(rotation_zoom_publisher_.getNumSubscribers() > 0 ||
                               translation_publisher_.getNumSubscribers() > 0);
@@ -341,6 +428,34 @@ void OdometryRos::process(const InputFrame& frame) {
   last_processing_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (!estimate) return;
+  if (parameters_.use_range && estimator_->config().initial_altitude > 0.0 && !scale_settled_) {
+    // The initial altitude was the first reading, whichever surface it saw; the first frames'
+    // readings and depth layers then vote which one it was (as oefmt_offline does ahead), and the
+    // altitude, so the scale from here on, is corrected once. Before that no reading is used.
+    constexpr int kScaleFrames = 20;
+    const std::optional<double> vertical = verticalRangeAt(frame, body_tilt_);
+    if (vertical && estimate->state == TrackingState::kTracking) {
+      scale_votes_.push_back({*vertical, estimator_->altitude(),
+                              depthRatios(estimate->registration12.translation_energy, estimator_->shiftPerBin(),
+                                          estimate->step.shift())});
+    }
+    if (++scale_frames_ >= kScaleFrames) {
+      scale_settled_ = true;
+      if (const std::optional<double> factor = rangeScale(scale_votes_)) {
+        estimator_->observeAltitude(*factor * estimator_->altitude(), 1e-6);
+        ROS_INFO_STREAM(name_ << ": scale from the rangefinder: the first readings fit a reference plane "
+                              << estimator_->altitude() << " m below");
+      }
+      scale_votes_.clear();
+    }
+  } else if (parameters_.use_range && estimator_->config().initial_altitude > 0.0) {
+    if (range_altitude_.update(*estimator_, *estimate, verticalRangeAt(frame, body_tilt_))) {
+      Estimate corrected = *estimate;
+      corrected.pose = estimator_->pose();
+      publish(frame, corrected);
+      return;
+    }
+  }
   publish(frame, *estimate);
 }
 
@@ -379,11 +494,26 @@ void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
   header.stamp = frame.stamp;
   header.frame_id = parameters_.odom_frame;
   const Pose4* previous = previous_pose_ ? &*previous_pose_ : nullptr;
-  odometry_publisher_.publish(odometryMessage(pose, previous, header, parameters_.base_frame));
-  previous_pose_ = pose;
-  if (parameters_.publish_tf) {
-    tf_broadcaster_.sendTransform(transformMessage(pose, header, parameters_.base_frame));
+  nav_msgs::Odometry odometry = odometryMessage(pose, previous, header, parameters_.base_frame);
+  geometry_msgs::TransformStamped transform = transformMessage(pose, header, parameters_.base_frame);
+  if (body_tilt_) {
+    // 6-DOF: roll and pitch from the IMU (observed, with its variance), x, y, z and yaw from the
+    // images.
+    const Eigen::Quaterniond q = cameraBodyOrientation(pose.yaw, *body_tilt_);
+    for (geometry_msgs::Quaternion* out : {&odometry.pose.pose.orientation, &transform.transform.rotation}) {
+      out->x = q.x();
+      out->y = q.y();
+      out->z = q.z();
+      out->w = q.w();
+    }
+    constexpr double kDefaultTiltVariance = 0.5 * M_PI / 180.0 * 0.5 * M_PI / 180.0;
+    const double variance = imu_orientation_variance_ > 0.0 ? imu_orientation_variance_ : kDefaultTiltVariance;
+    odometry.pose.covariance[3 * 6 + 3] = variance;
+    odometry.pose.covariance[4 * 6 + 4] = variance;
   }
+  odometry_publisher_.publish(odometry);
+  previous_pose_ = pose;
+  if (parameters_.publish_tf) tf_broadcaster_.sendTransform(transform);
   if (parameters_.path_length > 0) {
     geometry_msgs::PoseStamped stamped;
     stamped.header = header;

@@ -11,7 +11,11 @@ Private parameters: ~compressed (bool), ~rate (playback speed factor), ~frames, 
 ~size (image size of the rendered flight), ~seed (scene), ~simulate_args (more oefmt_simulate
 options, e.g. a lens distortion that goes into the bag's CameraInfo), ~camera_info_scale (the
 bag's CameraInfo rewritten for a camera of that many times the images' resolution, which the
-node and oefmt_offline map back to the images).
+node and oefmt_offline map back to the images), ~vehicle_bag (the bag written by oefmt_simulate
+itself, with the IMU and rangefinder its ~simulate_args ask for), ~expect_tilt (the odometry
+must carry roll and pitch), ~play_topics (the bag's topics to play, those the odometry
+subscribes to; default all), ~max_rigid_ate_mean [m] (the same error without scale alignment: a
+metric odometry).
 """
 import json
 import math
@@ -80,6 +84,9 @@ class ReplayCheck(unittest.TestCase):
         cls.seed = int(rospy.get_param("~seed", 3))
         cls.simulate_args = str(rospy.get_param("~simulate_args", "")).split()
         cls.camera_info_scale = float(rospy.get_param("~camera_info_scale", 1.0))
+        cls.vehicle_bag = rospy.get_param("~vehicle_bag", False)
+        cls.expect_tilt = rospy.get_param("~expect_tilt", False)
+        cls.max_rigid_ate_mean = float(rospy.get_param("~max_rigid_ate_mean", 0.0))
         # With ~mount_yaw, the camera body is mounted turned by that yaw in base_link (static
         # TF base_link -> camera_optical): the node's odometry is the offline one turned by it.
         cls.mount_yaw = float(rospy.get_param("~mount_yaw", 0.0))
@@ -93,8 +100,10 @@ class ReplayCheck(unittest.TestCase):
         length = 491.0 * cls.frames / 200.0
         run([tool("oefmt_simulate"), "--quiet", "--track", "circle", "--length", str(length),
              "--frames", str(cls.frames), "--size", str(cls.size), "--seed", str(cls.seed)]
-            + cls.simulate_args + [cls.flight])
-        if cls.compressed:
+            + cls.simulate_args + (["--bag", cls.bag] if cls.vehicle_bag else []) + [cls.flight])
+        if cls.vehicle_bag:
+            pass
+        elif cls.compressed:
             run([tool("oefmt_folder_to_bag"), "--quiet", "--format", "png", cls.flight, cls.bag])
         else:
             run([tool("oefmt_folder_to_bag"), "--quiet", cls.flight, cls.bag])
@@ -139,8 +148,10 @@ class ReplayCheck(unittest.TestCase):
         cls.wait_for_connections(cls.outputs, timeout=10.0)
         # Registered at the master is not yet connected: without --wait-for-subscribers the
         # first frames can be published before the odometry's connection is up (seen on CI).
+        # --wait-for-subscribers waits for every topic played: only those the odometry reads.
+        topics = str(rospy.get_param("~play_topics", "")).split()
         run(["rosbag", "play", "--clock", "--quiet", "--wait-for-subscribers", "-r", str(cls.rate),
-             cls.bag])
+             cls.bag] + (["--topics"] + topics if topics else []))
         time.sleep(2.0)  # let the last frames through
 
     @staticmethod
@@ -234,6 +245,17 @@ class ReplayCheck(unittest.TestCase):
                       m.pose.pose.orientation.z, m.pose.pose.orientation.w]
             self.assertTrue(all(math.isfinite(v) for v in values))
 
+    def test_attitude_from_the_imu(self):
+        with self.lock:
+            messages = list(self.odometry)
+        tilt = max(max(abs(m.pose.pose.orientation.x), abs(m.pose.pose.orientation.y)) for m in messages)
+        if self.expect_tilt:
+            self.assertGreater(tilt, 0.01, "the odometry carries no roll or pitch")
+            # Observed: the IMU's variance, not the unobserved one of a level-only estimate.
+            self.assertLess(messages[-1].pose.covariance[3 * 6 + 3], 1.0)
+        else:
+            self.assertLess(tilt, 1e-9, "a level odometry without an IMU")
+
     def test_tf_odom_to_base_link(self):
         last = self.poses()[-1]
         transform = self.tf_buffer.lookup_transform("odom", "base_link", rospy.Time.from_sec(last[0]),
@@ -284,6 +306,12 @@ class ReplayCheck(unittest.TestCase):
                       result["ate"]["max"], result["drift_percent"])
         self.assertEqual(result["matched"], self.frames)
         self.assertLess(result["ate"]["mean"], self.max_ate_mean, json.dumps(result))
+        if self.max_rigid_ate_mean > 0.0:  # metric: no scale alignment
+            output = run([tool("oefmt_evaluate"), "--json-only", "--no-scale", "--tolerance", "0.01", estimate,
+                          os.path.join(self.flight, "groundtruth.tum")])
+            rigid = json.loads(output.strip().splitlines()[-1])
+            rospy.loginfo("replay: node rigid ATE mean %.4f m", rigid["ate"]["mean"])
+            self.assertLess(rigid["ate"]["mean"], self.max_rigid_ate_mean, json.dumps(rigid))
 
     def test_same_trajectory_as_offline(self):
         if not self.compare_offline:

@@ -25,6 +25,12 @@ struct RosParameters {
   bool undistort = true;
   /// Take the initial altitude from the `altitude` Range topic (over initial_altitude).
   bool use_altitude_topic = false;
+  /// Level every frame with the `imu` topic's roll and pitch whenever it publishes.
+  bool use_imu = true;
+  double imu_timeout = 0.1;          ///< [s] an IMU orientation further than this from a frame is stale
+  /// Keep the scale metric with every valid `altitude` range (off until the node's use of the
+  /// readings matches oefmt_offline's accuracy).
+  bool use_range = false;
   double time_jump_tolerance = 1.0;  ///< a stamp this far back [s] resets (bag loop)
   double diagnostics_period = 1.0;   ///< [s]
   double min_rate = 1.0;             ///< expected input/output rate window [Hz] for diagnostics

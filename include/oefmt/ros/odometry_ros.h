@@ -22,6 +22,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
 #include <sensor_msgs/Range.h>
 #include <std_msgs/Header.h>
 #include <std_srvs/Empty.h>
@@ -30,7 +31,11 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "oefmt/estimation/estimator.h"
+#include "oefmt/estimation/attitude.h"
 #include "oefmt/estimation/estimator_config.h"
+#include "oefmt/estimation/range_gate.h"
+#include "oefmt/io/nadir_view.h"
+#include "oefmt/io/vehicle_data.h"
 #include "oefmt/ros/frame_queue.h"
 #include "oefmt/ros/node_parameters.h"
 #include "oefmt/ros/stamp_guard.h"
@@ -63,6 +68,11 @@ class OdometryRos {
   void compressedCallback(const sensor_msgs::CompressedImageConstPtr& message);
   void cameraInfoCallback(const sensor_msgs::CameraInfoConstPtr& message);
   void altitudeCallback(const sensor_msgs::RangeConstPtr& message);
+  void imuCallback(const sensor_msgs::ImuConstPtr& message);
+  /// The camera's tilt at the frame (nothing without an IMU, or when it is stale).
+  std::optional<CameraTilt> tiltAt(const InputFrame& frame);
+  /// The rangefinder's reading at the frame, vertical (nothing without one near the stamp).
+  std::optional<double> verticalRangeAt(const InputFrame& frame, const std::optional<CameraTilt>& tilt);
   bool resetService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   /// Stamps the frame from its message header and hands it to the worker.
   void enqueue(InputFrame frame, const std_msgs::Header& header);
@@ -86,7 +96,7 @@ class OdometryRos {
 
   image_transport::ImageTransport image_transport_;
   image_transport::Subscriber image_subscriber_;
-  ros::Subscriber compressed_subscriber_, camera_info_subscriber_, altitude_subscriber_;
+  ros::Subscriber compressed_subscriber_, camera_info_subscriber_, altitude_subscriber_, imu_subscriber_;
   ros::Publisher odometry_publisher_, path_publisher_, energy_publisher_;
   image_transport::Publisher energy_image_publisher_, rotation_zoom_publisher_,
       translation_publisher_;
@@ -100,6 +110,11 @@ class OdometryRos {
   std::condition_variable camera_ready_;
   sensor_msgs::CameraInfoConstPtr camera_info_;
   std::optional<double> altitude_from_topic_;
+  // The IMU's orientations and the rangefinder's recent readings: guarded by vehicle_mutex_.
+  std::mutex vehicle_mutex_;
+  AttitudeHistory attitudes_;
+  double imu_orientation_variance_ = 0.0;  ///< roll and pitch variance the IMU reports [rad^2]
+  std::deque<RangeSample> ranges_;
 
   // Worker state (worker thread only).
   FrameQueue<InputFrame> queue_;
@@ -109,6 +124,15 @@ class OdometryRos {
   nav_msgs::Path path_;
   std::optional<Pose4> previous_pose_;
   double mount_yaw_ = 0.0;  ///< yaw of the camera body (x = image right) in base_frame, from TF
+  Eigen::Matrix3d mount_ = downLookingMount();  ///< the optical frame in base_frame, from TF
+  std::unique_ptr<const NadirView> nadir_;       ///< levels tilted frames (with undistorter_)
+  RangeAltitude range_altitude_;
+  /// The first frames' readings, until they settle which layer the rangefinder saw (rangeScale).
+  std::vector<RangeObservation> scale_votes_;
+  int scale_frames_ = 0;
+  bool scale_settled_ = false;
+  std::optional<CameraTilt> body_tilt_;          ///< base_frame's roll and pitch at the last frame
+  long unlevelled_ = 0;                          ///< frames taken as level for want of an attitude
   cv::Size input_size_;
   double estimator_fx_ = 0.0;
   std::unique_ptr<const Undistorter> undistorter_;  ///< of the current calibration and image size
