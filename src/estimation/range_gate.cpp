@@ -47,15 +47,20 @@ RangeAltitude::RangeAltitude(double reading_sigma, double attitude_sigma)
 
 bool RangeAltitude::update(Estimator& estimator, const Estimate& estimate, std::optional<double> vertical) {
   if (!vertical || estimate.state != TrackingState::kTracking) return false;
-  const std::vector<double> layers =
-      depthRatios(estimate.registration12.translation_energy, estimator.shiftPerBin(), estimate.step.shift());
-  const std::optional<double> altitude = gate_.measure(*vertical, estimator.altitude(), layers);
+  const RangeObservation observation = rangeObservation(estimator, estimate, *vertical);
+  const std::optional<double> altitude =
+      gate_.measure(observation.vertical, observation.predicted, observation.depth_ratios);
   if (!altitude) return false;
   const double unseen = std::hypot(estimate.pose.x - last_x_, estimate.pose.y - last_y_) * attitude_sigma_;
   estimator.observeAltitude(*altitude, reading_sigma_, unseen * unseen);
   last_x_ = estimator.pose().x;
   last_y_ = estimator.pose().y;
   return true;
+}
+
+RangeObservation rangeObservation(const Estimator& estimator, const Estimate& estimate, double vertical) {
+  return {vertical, estimator.altitude(),
+          depthRatios(estimate.registration12.translation_energy, estimator.shiftPerBin(), estimate.step.shift())};
 }
 
 std::optional<double> rangeScale(const std::vector<RangeObservation>& observations, double gate, int min_support) {

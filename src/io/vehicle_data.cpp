@@ -81,6 +81,13 @@ std::optional<RangeSample> rangeAt(const std::vector<RangeSample>& readings, dou
   return nearest;
 }
 
+std::optional<double> verticalRange(const std::vector<RangeSample>& readings, double stamp, double tolerance,
+                                    const std::optional<CameraTilt>& tilt) {
+  const std::optional<RangeSample> reading = rangeAt(readings, stamp, tolerance);
+  if (!reading || !std::isfinite(reading->range)) return std::nullopt;
+  return reading->range * (tilt ? std::cos(tilt->roll) * std::cos(tilt->pitch) : 1.0);
+}
+
 std::vector<ImuSample> readImuFile(const std::string& path) {
   std::vector<ImuSample> samples;
   readTable(path, 11, "t qx qy qz qw wx wy wz ax ay az", [&](const std::vector<double>& v, const std::string& where) {

@@ -427,33 +427,28 @@ void BagFlightWriter::write(const cv::Mat& image, double stamp) {
 }
 
 void BagFlightWriter::writeImu(const ImuSample& sample) {
-  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
-  try {
-    state_->bag.write(options_.imu_topic, rosTime(sample.stamp), imuMessage(sample, options_.imu_frame));
-  } catch (const rosbag::BagException& e) {
-    throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
-  }
+  writeMessage(options_.imu_topic, sample.stamp, imuMessage(sample, options_.imu_frame));
 }
 
 void BagFlightWriter::writeRange(const RangeSample& sample) {
-  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
-  try {
-    state_->bag.write(options_.range_topic, rosTime(sample.stamp), rangeMessage(sample, options_.range_frame));
-  } catch (const rosbag::BagException& e) {
-    throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
-  }
+  writeMessage(options_.range_topic, sample.stamp, rangeMessage(sample, options_.range_frame));
 }
 
 void BagFlightWriter::writeMounts(double stamp) {
-  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
   tf2_msgs::TFMessage mounts;
   const double half = std::sqrt(0.5);
   mounts.transforms.push_back(staticTransform(options_.base_frame, options_.frame_id, stamp, 1.0, 0.0, 0.0, 0.0));
   mounts.transforms.push_back(staticTransform(options_.base_frame, options_.imu_frame, stamp, 0.0, 0.0, 0.0, 1.0));
   // +90 degrees about y: the rangefinder's x (its beam) along the body's -z.
   mounts.transforms.push_back(staticTransform(options_.base_frame, options_.range_frame, stamp, 0.0, half, 0.0, half));
+  writeMessage("/tf_static", stamp, mounts);
+}
+
+template <typename Message>
+void BagFlightWriter::writeMessage(const std::string& topic, double stamp, const Message& message) {
+  if (!state_->open) throw BagError("bag '" + state_->path + "' is closed");
   try {
-    state_->bag.write("/tf_static", rosTime(stamp), mounts);
+    state_->bag.write(topic, rosTime(stamp), message);
   } catch (const rosbag::BagException& e) {
     throw BagError("cannot write to bag '" + state_->path + "': " + e.what());
   }

@@ -172,7 +172,7 @@ void OdometryRos::altitudeCallback(const sensor_msgs::RangeConstPtr& message) {
     std::lock_guard<std::mutex> lock(vehicle_mutex_);
     ranges_.push_back({message->header.stamp.toSec(), message->range});
     constexpr std::size_t kKeptReadings = 50;
-    if (ranges_.size() > kKeptReadings) ranges_.pop_front();
+    if (ranges_.size() > kKeptReadings) ranges_.erase(ranges_.begin());
   }
   {
     std::lock_guard<std::mutex> lock(camera_mutex_);
@@ -222,13 +222,8 @@ std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
 
 std::optional<double> OdometryRos::verticalRangeAt(const InputFrame& frame, const std::optional<CameraTilt>& tilt) {
   constexpr double kRangeMatch = 0.05;  // [s]: a reading belongs to a frame this near
-  std::optional<RangeSample> reading;
-  {
-    std::lock_guard<std::mutex> lock(vehicle_mutex_);
-    reading = rangeAt(std::vector<RangeSample>(ranges_.begin(), ranges_.end()), frame.stamp.toSec(), kRangeMatch);
-  }
-  if (!reading) return std::nullopt;
-  return reading->range * (tilt ? std::cos(tilt->roll) * std::cos(tilt->pitch) : 1.0);
+  std::lock_guard<std::mutex> lock(vehicle_mutex_);
+  return verticalRange(ranges_, frame.stamp.toSec(), kRangeMatch, tilt);
 }
 
 bool OdometryRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -435,9 +430,7 @@ void OdometryRos::process(const InputFrame& frame) {
     constexpr int kScaleFrames = 20;
     const std::optional<double> vertical = verticalRangeAt(frame, body_tilt_);
     if (vertical && estimate->state == TrackingState::kTracking) {
-      scale_votes_.push_back({*vertical, estimator_->altitude(),
-                              depthRatios(estimate->registration12.translation_energy, estimator_->shiftPerBin(),
-                                          estimate->step.shift())});
+      scale_votes_.push_back(rangeObservation(*estimator_, *estimate, *vertical));
     }
     if (++scale_frames_ >= kScaleFrames) {
       scale_settled_ = true;

@@ -134,14 +134,29 @@ oefmt::FrameSpectra cloneSpectra(const oefmt::FrameSpectra& s) {
 // A reading belongs to a frame within this of its stamp [s].
 constexpr double kRangeMatch = 0.02;
 
-// The reading at `stamp` turned vertical with the camera's tilt (level without one); nothing
-// when there is none near the stamp or it had no return.
+// A frame's reading, vertical (oefmt::verticalRange).
 std::optional<double> verticalRange(const std::vector<oefmt::RangeSample>& ranges, double stamp,
                                     const std::optional<oefmt::CameraTilt>& tilt) {
-  const std::optional<oefmt::RangeSample> reading = oefmt::rangeAt(ranges, stamp, kRangeMatch);
-  if (!reading || !std::isfinite(reading->range)) return std::nullopt;
-  const double cosine = tilt ? std::cos(tilt->roll) * std::cos(tilt->pitch) : 1.0;
-  return reading->range * cosine;
+  return oefmt::verticalRange(ranges, stamp, kRangeMatch, tilt);
+}
+
+// A vehicle sensor's samples: the folder's `file_name` when it is there, else the bag's `topic`
+// when one is given; `source` names where they came from (empty: nowhere).
+template <typename Sample>
+std::vector<Sample> readVehicleData(const Options& o, const char* file_name, const std::string& topic,
+                                    std::vector<Sample> (*read_file)(const std::string&),
+                                    std::vector<Sample> (*read_topic)(const std::string&, const std::string&),
+                                    std::string& source) {
+  source.clear();
+  if (!o.images.empty() && std::filesystem::exists(o.images + "/" + file_name)) {
+    source = o.images + "/" + file_name;
+    return read_file(source);
+  }
+  if (!o.bag.empty() && !topic.empty()) {
+    source = topic;
+    return read_topic(o.bag, topic);
+  }
+  return {};
 }
 
 void writeDiagnosticsHeader(std::ostream& out) {
@@ -229,19 +244,14 @@ int main(int argc, char** argv) {
     // Attitude-aided registration: a folder's imu.txt or a bag's --imu-topic (its frame is taken
     // as the camera body) gives each frame's roll and pitch, with which the frame is turned into a
     // level camera's view.
-    std::vector<oefmt::ImuSample> imu_samples;
     std::string imu_source;
-    if (options.use_imu && !options.images.empty() &&
-        std::filesystem::exists(options.images + "/" + oefmt::kImuFileName)) {
-      imu_source = options.images + "/" + oefmt::kImuFileName;
-      imu_samples = oefmt::readImuFile(imu_source);
-    } else if (options.use_imu && !options.bag.empty() && !options.imu_topic.empty()) {
-      imu_source = options.imu_topic;
-      imu_samples = oefmt::readImuTopic(options.bag, options.imu_topic);
-      if (imu_samples.empty()) {
-        std::fprintf(stderr, "oefmt_offline: warning: %s has no orientation: the frames are taken as level\n",
-                     imu_source.c_str());
-      }
+    const std::vector<oefmt::ImuSample> imu_samples =
+        options.use_imu ? readVehicleData(options, oefmt::kImuFileName, options.imu_topic, &oefmt::readImuFile,
+                                          &oefmt::readImuTopic, imu_source)
+                        : std::vector<oefmt::ImuSample>{};
+    if (!options.bag.empty() && !imu_source.empty() && imu_samples.empty()) {
+      std::fprintf(stderr, "oefmt_offline: warning: %s has no orientation: the frames are taken as level\n",
+                   imu_source.c_str());
     }
     std::shared_ptr<oefmt::AttitudeHistory> attitudes;
     std::shared_ptr<const oefmt::NadirView> nadir;
@@ -264,16 +274,11 @@ int main(int argc, char** argv) {
     // A downward rangefinder (a folder's range.txt or a bag's --range-topic): the initial altitude
     // when none is given, and the altitude above the reference plane all along (oefmt::RangeGate
     // tells those readings from roofs'), which keeps the scale metric.
-    std::vector<oefmt::RangeSample> ranges;
     std::string range_source;
-    if (options.use_range && !options.images.empty() &&
-        std::filesystem::exists(options.images + "/" + oefmt::kRangeFileName)) {
-      range_source = options.images + "/" + oefmt::kRangeFileName;
-      ranges = oefmt::readRangeFile(range_source);
-    } else if (options.use_range && !options.bag.empty() && !options.range_topic.empty()) {
-      range_source = options.range_topic;
-      ranges = oefmt::readRangeTopic(options.bag, options.range_topic);
-    }
+    const std::vector<oefmt::RangeSample> ranges =
+        options.use_range ? readVehicleData(options, oefmt::kRangeFileName, options.range_topic,
+                                            &oefmt::readRangeFile, &oefmt::readRangeTopic, range_source)
+                          : std::vector<oefmt::RangeSample>{};
     if (!ranges.empty() && !options.quiet) std::fprintf(stderr, "oefmt_offline: altitude from %s\n", range_source.c_str());
     oefmt::RangeAltitude range_altitude;
     // The reader thread decodes each frame and makes its spectra (the frame's FFTs) while this
@@ -344,9 +349,7 @@ int main(int argc, char** argv) {
         replay.push_back(std::move(ahead));
         const std::optional<oefmt::Estimate> e = provisional->push(std::move(copy.spectra), copy.stamp);
         if (!e || !vertical) continue;
-        observations.push_back({*vertical, provisional->altitude(),
-                                oefmt::depthRatios(e->registration12.translation_energy, provisional->shiftPerBin(),
-                                                   e->step.shift())});
+        observations.push_back(oefmt::rangeObservation(*provisional, *e, *vertical));
       }
       if (provisional) {
         const double first = provisional->config().initial_altitude;

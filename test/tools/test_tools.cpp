@@ -467,6 +467,18 @@ TEST(Tools, OfflineLevelsTiltedFramesWithTheImuAndScalesWithTheRangefinder) {
     largest_tilt = std::max({largest_tilt, std::fabs(pose.orientation.x()), std::fabs(pose.orientation.y())});
   }
   EXPECT_GT(largest_tilt, 0.02);
+
+  // Bad vehicle data stops the run with one line naming it (exit status 1).
+  const auto expectRefused = [&](const std::string& arguments, const std::string& message) {
+    const ToolRun refused = run(dir, offline + " --quiet " + arguments + " --output " + (dir / "refused.tum"));
+    EXPECT_EQ(refused.status, 1) << arguments;
+    EXPECT_NE(refused.err.find(message), std::string::npos) << arguments << ": " << refused.err;
+  };
+  expectRefused("--bag " + (dir / "flight.bag") + " --imu-topic /camera/camera_info",
+                "/camera/camera_info holds sensor_msgs/CameraInfo, not sensor_msgs/Imu");
+  expectRefused("--bag " + (dir / "flight.bag") + " --range-topic /nothing", "has no messages on /nothing");
+  std::ofstream(dir / "flight/imu.txt", std::ios::app) << "99 0 0\n";
+  expectRefused("--images " + (dir / "flight"), "imu.txt' line ");
 }
 
 TEST(Tools, MeasureSpeedReportsEveryRun) {

@@ -72,6 +72,10 @@ struct RangeObservation {
   std::vector<double> depth_ratios;   ///< depthRatios() of that frame
 };
 
+/// The observation of a reading for the frame `estimator` just gave `estimate` for: the
+/// estimator's altitude and the depth ratios of that frame's layers.
+RangeObservation rangeObservation(const Estimator& estimator, const Estimate& estimate, double vertical);
+
 /// The factor that turns the estimator's altitudes into the reference plane's metric depth, from
 /// the first frames' readings, whichever layer each read: every reading proposes one factor per
 /// layer (vertical / (c_l predicted)), and the factor most readings fit (within `gate`, through

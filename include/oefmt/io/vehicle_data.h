@@ -18,6 +18,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "oefmt/estimation/attitude.h"
+
 namespace oefmt {
 
 struct ImuSample {
@@ -34,6 +36,12 @@ struct RangeSample {
 
 /// The reading nearest `stamp` if within `tolerance` [s] of it (any value, +inf included).
 std::optional<RangeSample> rangeAt(const std::vector<RangeSample>& readings, double stamp, double tolerance);
+
+/// The reading nearest `stamp` (within `tolerance` [s]) turned vertical with the camera's tilt
+/// (level without one): the depth of the surface below. Nothing without a reading there or when
+/// it had no return.
+std::optional<double> verticalRange(const std::vector<RangeSample>& readings, double stamp, double tolerance,
+                                    const std::optional<CameraTilt>& tilt);
 
 /// The file names inside a dataset folder.
 constexpr const char* kImuFileName = "imu.txt";

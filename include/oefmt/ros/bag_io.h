@@ -132,6 +132,10 @@ class BagFlightWriter {
   std::size_t written() const { return written_; }
 
  private:
+  /// One message on `topic` at `stamp` (BagError when closed or on a write failure).
+  template <typename Message>
+  void writeMessage(const std::string& topic, double stamp, const Message& message);
+
   struct State;
   std::unique_ptr<State> state_;
   CameraParameters camera_;

@@ -114,7 +114,7 @@ class OdometryRos {
   std::mutex vehicle_mutex_;
   AttitudeHistory attitudes_;
   double imu_orientation_variance_ = 0.0;  ///< roll and pitch variance the IMU reports [rad^2]
-  std::deque<RangeSample> ranges_;
+  std::vector<RangeSample> ranges_;  ///< the latest readings, oldest first (bounded)
 
   // Worker state (worker thread only).
   FrameQueue<InputFrame> queue_;
