@@ -20,6 +20,18 @@ Eigen::Matrix3d tiltRotation(const CameraTilt& tilt) {
 
 }  // namespace
 
+double tiltAngle(const CameraTilt& tilt) {
+  return std::acos(std::clamp(std::cos(tilt.roll) * std::cos(tilt.pitch), -1.0, 1.0));
+}
+
+void addUnknownTilt(std::array<double, 36>& covariance, double altitude, double tilt_sigma) {
+  if (!std::isfinite(altitude) || !std::isfinite(tilt_sigma) || !(tilt_sigma > 0.0)) return;
+  const double shift = std::fabs(altitude) * std::tan(std::min(tilt_sigma, 0.49 * M_PI));
+  covariance[0 * 6 + 0] += shift * shift;
+  covariance[1 * 6 + 1] += shift * shift;
+  for (const int axis : {3, 4}) covariance[axis * 6 + axis] = tilt_sigma * tilt_sigma;
+}
+
 CameraTilt cameraTilt(const Eigen::Matrix3d& world_from_optical) {
   const Eigen::Matrix3d body = world_from_optical * flipX();
   // Rz(yaw) Ry(pitch) Rx(roll): row 2 is (-sin p, cos p sin r, cos p cos r), free of the yaw.

@@ -196,6 +196,7 @@ void OdometryRos::imuCallback(const sensor_msgs::ImuConstPtr& message) {
 }
 
 std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
+  frame_unlevelled_ = false;
   std::optional<Eigen::Quaterniond> body;
   {
     std::lock_guard<std::mutex> lock(vehicle_mutex_);
@@ -213,10 +214,12 @@ std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
                                                 << " s of the frame: taken as level (" << unlevelled_
                                                 << " frames so far)");
     body_tilt_.reset();
+    frame_unlevelled_ = true;
     return std::nullopt;
   }
   // The IMU's frame is taken as base_frame: its own roll and pitch, and the camera's by the mount.
   body_tilt_ = cameraTilt(body->toRotationMatrix() * downLookingMount());
+  largest_tilt_ = std::max(largest_tilt_, tiltAngle(*body_tilt_));
   return cameraTilt(body->toRotationMatrix() * mount_);
 }
 
@@ -503,6 +506,13 @@ void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
     const double variance = imu_orientation_variance_ > 0.0 ? imu_orientation_variance_ : kDefaultTiltVariance;
     odometry.pose.covariance[3 * 6 + 3] = variance;
     odometry.pose.covariance[4 * 6 + 4] = variance;
+  } else if (frame_unlevelled_) {
+    // The IMU went quiet and the frame was taken as level: its tilt, up to the largest the
+    // vehicle showed, is in the position and unknown in roll and pitch.
+    std::array<double, 36> covariance;
+    std::copy(odometry.pose.covariance.begin(), odometry.pose.covariance.end(), covariance.begin());
+    addUnknownTilt(covariance, estimator_->altitude(), largest_tilt_);
+    std::copy(covariance.begin(), covariance.end(), odometry.pose.covariance.begin());
   }
   odometry_publisher_.publish(odometry);
   previous_pose_ = pose;

@@ -5,6 +5,7 @@
 // translation (while the raw frames register as tens of pixels of it).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -38,6 +39,19 @@ TEST(Attitude, TiltComesBackFromTheOrientationWhateverTheYaw) {
   const Eigen::Matrix3d optical = opticalOf(cameraBodyOrientation(yaw, tilt));
   const Eigen::Matrix3d virtual_optical = optical * nadirFromOptical(tilt).transpose();
   EXPECT_TRUE(virtual_optical.col(2).isApprox(Eigen::Vector3d(0.0, 0.0, -1.0), 1e-12));
+}
+
+TEST(Attitude, TiltAngleIsTheViewsAngleFromStraightDown) {
+  EXPECT_NEAR(tiltAngle(CameraTilt{0.2, 0.0}), 0.2, 1e-12);
+  EXPECT_NEAR(tiltAngle(CameraTilt{0.0, -0.3}), 0.3, 1e-12);
+  // Roll then pitch: the view's z is (cos p cos r) down.
+  EXPECT_NEAR(tiltAngle(CameraTilt{0.1, 0.2}), std::acos(std::cos(0.1) * std::cos(0.2)), 1e-12);
+  EXPECT_EQ(tiltAngle(CameraTilt{}), 0.0);
+  // Nothing added without a tilt to fear, or with a meaningless one.
+  std::array<double, 36> covariance{};
+  addUnknownTilt(covariance, 20.0, 0.0);
+  addUnknownTilt(covariance, std::nan(""), 0.1);
+  for (const double c : covariance) EXPECT_EQ(c, 0.0);
 }
 
 TEST(Attitude, HistoryInterpolatesBetweenSamplesAndNotAcrossGaps) {
@@ -97,6 +111,18 @@ TEST(AttitudeAidedRegistration, PureRollOrPitchRegistersAsNoTranslation) {
     // Unaided, the tilt is seen as a shift of about f tan(tilt): 19-23 px here.
     const double seen_as_shift = plan.camera.intrinsics.fx * std::tan(std::hypot(tilt.roll, tilt.pitch));
     EXPECT_NEAR(cv::norm(unaided.translation), seen_as_shift, 0.15 * seen_as_shift) << tilt.roll << " " << tilt.pitch;
+    // A frame the node must take as level (its IMU went quiet) carries that shift in its
+    // position's covariance: per axis, one sigma of a tilt as large as this one reaches it.
+    std::array<double, 36> covariance{};
+    addUnknownTilt(covariance, options.track.altitude, tiltAngle(tilt));
+    const double metres_per_px = options.track.altitude / plan.camera.intrinsics.fx;
+    EXPECT_NEAR(std::hypot(unaided.translation.x, unaided.translation.y) * metres_per_px,
+                std::sqrt(covariance[0]), 0.15 * std::sqrt(covariance[0]));
+    EXPECT_LE(std::fabs(unaided.translation.x) * metres_per_px, 1.15 * std::sqrt(covariance[0]));
+    EXPECT_LE(std::fabs(unaided.translation.y) * metres_per_px, 1.15 * std::sqrt(covariance[7]));
+    EXPECT_DOUBLE_EQ(covariance[3 * 6 + 3], tiltAngle(tilt) * tiltAngle(tilt));
+    EXPECT_DOUBLE_EQ(covariance[4 * 6 + 4], tiltAngle(tilt) * tiltAngle(tilt));
+    EXPECT_DOUBLE_EQ(covariance[2 * 6 + 2], 0.0);  // the altitude is not what a tilt changes
     EXPECT_LT(cv::norm(aided.translation), 0.5) << tilt.roll << " " << tilt.pitch;
     EXPECT_NEAR(aided.rotation, 0.0, 0.2 * kDeg);
     EXPECT_NEAR(aided.zoom, 1.0, 0.003);

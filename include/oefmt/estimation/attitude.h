@@ -9,6 +9,7 @@
 // the yaw; the IMU gives pitch and roll, which are measured against gravity and need no compass.
 #pragma once
 
+#include <array>
 #include <deque>
 #include <optional>
 
@@ -28,6 +29,17 @@ CameraTilt cameraTilt(const Eigen::Matrix3d& world_from_optical);
 /// The rotation from the tilted camera's optical frame to the virtual nadir camera's: the same
 /// yaw, no tilt.
 Eigen::Matrix3d nadirFromOptical(const CameraTilt& tilt);
+
+/// The angle between a tilted camera's view and straight down [rad].
+double tiltAngle(const CameraTilt& tilt);
+
+/// A frame taken as level because its attitude is unknown (the IMU went quiet), of a vehicle
+/// that tilts up to about `tilt_sigma` [rad]: its tilt is read as a shift of the position by up to
+/// altitude * tan(tilt_sigma) in x and y (not a drift: a step between two such frames reads the
+/// difference of their tilts, so the shift is undone once frames are levelled again), and its
+/// roll and pitch are unknown within tilt_sigma. Adds both to `covariance`, a 6x6 pose covariance
+/// (x y z roll pitch yaw, row-major, REP-103); `altitude` in the position's unit.
+void addUnknownTilt(std::array<double, 36>& covariance, double altitude, double tilt_sigma);
 
 /// The camera body's orientation (body to world) of a yaw and a tilt.
 Eigen::Quaterniond cameraBodyOrientation(double yaw, const CameraTilt& tilt);

@@ -133,6 +133,8 @@ class OdometryRos {
   bool scale_settled_ = false;
   std::optional<CameraTilt> body_tilt_;          ///< base_frame's roll and pitch at the last frame
   long unlevelled_ = 0;                          ///< frames taken as level for want of an attitude
+  bool frame_unlevelled_ = false;  ///< the current frame: taken as level although the IMU had spoken
+  double largest_tilt_ = 0.0;      ///< base_frame's largest tilt the IMU gave at a frame [rad]
   cv::Size input_size_;
   double estimator_fx_ = 0.0;
   std::unique_ptr<const Undistorter> undistorter_;  ///< of the current calibration and image size
