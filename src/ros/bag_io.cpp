@@ -427,7 +427,13 @@ void BagFlightWriter::write(const cv::Mat& image, double stamp) {
 }
 
 void BagFlightWriter::writeImu(const ImuSample& sample) {
-  writeMessage(options_.imu_topic, sample.stamp, imuMessage(sample, options_.imu_frame));
+  // The IMU's own frame: world <- imu = (world <- body)(body <- imu); vectors turned into it.
+  ImuSample own = sample;
+  const Eigen::Quaterniond& mount = options_.imu_mount;
+  own.orientation = (sample.orientation * mount).normalized();
+  own.angular_velocity = mount.conjugate() * sample.angular_velocity;
+  own.linear_acceleration = mount.conjugate() * sample.linear_acceleration;
+  writeMessage(options_.imu_topic, sample.stamp, imuMessage(own, options_.imu_frame));
 }
 
 void BagFlightWriter::writeRange(const RangeSample& sample) {
@@ -438,7 +444,8 @@ void BagFlightWriter::writeMounts(double stamp) {
   tf2_msgs::TFMessage mounts;
   const double half = std::sqrt(0.5);
   mounts.transforms.push_back(staticTransform(options_.base_frame, options_.frame_id, stamp, 1.0, 0.0, 0.0, 0.0));
-  mounts.transforms.push_back(staticTransform(options_.base_frame, options_.imu_frame, stamp, 0.0, 0.0, 0.0, 1.0));
+  const Eigen::Quaterniond imu = options_.imu_mount.normalized();
+  mounts.transforms.push_back(staticTransform(options_.base_frame, options_.imu_frame, stamp, imu.x(), imu.y(), imu.z(), imu.w()));
   // +90 degrees about y: the rangefinder's x (its beam) along the body's -z.
   mounts.transforms.push_back(staticTransform(options_.base_frame, options_.range_frame, stamp, 0.0, half, 0.0, half));
   writeMessage("/tf_static", stamp, mounts);

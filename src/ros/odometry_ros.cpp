@@ -189,17 +189,37 @@ void OdometryRos::imuCallback(const sensor_msgs::ImuConstPtr& message) {
   }
   const ImuSample sample = imuSample(*message);
   std::lock_guard<std::mutex> lock(vehicle_mutex_);
+  imu_frame_ = message->header.frame_id;
   attitudes_.add(sample.stamp, sample.orientation);
   attitudes_.forgetBefore(sample.stamp - 10.0);  // frames older than that are long processed
   const double roll = message->orientation_covariance[0], pitch = message->orientation_covariance[4];
   imu_orientation_variance_ = std::isfinite(roll) && std::isfinite(pitch) ? std::max({roll, pitch, 0.0}) : 0.0;
 }
 
+const Eigen::Matrix3d& OdometryRos::imuMount(const std::string& imu_frame) {
+  if (imu_frame == imu_mount_frame_) return imu_mount_;
+  imu_mount_frame_ = imu_frame;
+  imu_mount_ = Eigen::Matrix3d::Identity();
+  if (imu_frame.empty() || imu_frame == parameters_.base_frame) return imu_mount_;
+  try {
+    const auto q = tf_buffer_.lookupTransform(parameters_.base_frame, imu_frame, ros::Time(0), ros::Duration(0.2))
+                       .transform.rotation;
+    imu_mount_ = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+    ROS_INFO_STREAM(name_ << ": IMU mount from TF: " << imu_frame << " in " << parameters_.base_frame);
+  } catch (const tf2::TransformException& e) {
+    ROS_WARN_STREAM(name_ << ": no TF " << parameters_.base_frame << " -> " << imu_frame << " (" << e.what()
+                          << "): the IMU's frame is taken as " << parameters_.base_frame);
+  }
+  return imu_mount_;
+}
+
 std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
   frame_unlevelled_ = false;
   std::optional<Eigen::Quaterniond> body;
+  std::string imu_frame;
   {
     std::lock_guard<std::mutex> lock(vehicle_mutex_);
+    imu_frame = imu_frame_;
     if (attitudes_.empty()) return std::nullopt;
     const double stamp = frame.stamp.toSec();
     body = attitudes_.at(stamp);
@@ -217,10 +237,12 @@ std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
     frame_unlevelled_ = true;
     return std::nullopt;
   }
-  // The IMU's frame is taken as base_frame: its own roll and pitch, and the camera's by the mount.
-  body_tilt_ = cameraTilt(body->toRotationMatrix() * downLookingMount());
+  // world <- base = (world <- imu)(imu <- base): base_frame's own roll and pitch, and the
+  // camera's by its mount.
+  const Eigen::Matrix3d base = body->toRotationMatrix() * imuMount(imu_frame).transpose();
+  body_tilt_ = cameraTilt(base * downLookingMount());
   largest_tilt_ = std::max(largest_tilt_, tiltAngle(*body_tilt_));
-  return cameraTilt(body->toRotationMatrix() * mount_);
+  return cameraTilt(base * mount_);
 }
 
 std::optional<double> OdometryRos::verticalRangeAt(const InputFrame& frame, const std::optional<CameraTilt>& tilt) {

@@ -7,6 +7,11 @@
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <tf2/buffer_core.h>
+#include <tf2/exceptions.h>
+#include <tf2_msgs/TFMessage.h>
 
 #include "oefmt/ros/bag_io.h"
 
@@ -130,6 +135,76 @@ std::vector<ImuSample> readImuTopic(const std::string& bag_path, const std::stri
 std::vector<RangeSample> readRangeTopic(const std::string& bag_path, const std::string& topic) {
   return readTopic<sensor_msgs::Range, RangeSample>(bag_path, topic,
                                                     [](const sensor_msgs::Range& m) { return rangeSample(m); });
+}
+
+namespace {
+
+template <typename Message>
+bool frameIdOf(const rosbag::MessageInstance& instance, std::string& frame_id) {
+  const auto message = instance.instantiate<Message>();
+  if (!message) return false;
+  frame_id = message->header.frame_id;
+  return true;
+}
+
+}  // namespace
+
+std::string firstFrameId(const std::string& bag_path, const std::string& topic) {
+  if (topic.empty()) return {};
+  try {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
+    rosbag::View view(bag, rosbag::TopicQuery(topic));
+    for (const rosbag::MessageInstance& instance : view) {
+      std::string frame_id;
+      if (frameIdOf<sensor_msgs::Imu>(instance, frame_id) || frameIdOf<sensor_msgs::Image>(instance, frame_id) ||
+          frameIdOf<sensor_msgs::CompressedImage>(instance, frame_id) ||
+          frameIdOf<sensor_msgs::Range>(instance, frame_id)) {
+        return frame_id;
+      }
+      return {};
+    }
+  } catch (const rosbag::BagException& e) {
+    throw BagError("cannot read bag '" + bag_path + "': " + e.what());
+  }
+  return {};
+}
+
+std::optional<Eigen::Quaterniond> staticRotation(const std::string& bag_path, const std::string& target,
+                                                 const std::string& source, std::string& why) {
+  why.clear();
+  if (target.empty() || source.empty()) {
+    why = "a frame id is empty";
+    return std::nullopt;
+  }
+  if (target == source) return Eigen::Quaterniond::Identity();
+  tf2::BufferCore buffer;
+  std::size_t transforms = 0;
+  try {
+    rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
+    rosbag::View view(bag, rosbag::TopicQuery("/tf_static"));
+    for (const rosbag::MessageInstance& instance : view) {
+      const auto message = instance.instantiate<tf2_msgs::TFMessage>();
+      if (!message) continue;
+      for (const geometry_msgs::TransformStamped& t : message->transforms) {
+        buffer.setTransform(t, "bag", true);
+        ++transforms;
+      }
+    }
+  } catch (const rosbag::BagException& e) {
+    throw BagError("cannot read bag '" + bag_path + "': " + e.what());
+  }
+  if (transforms == 0) {
+    why = "the bag has no /tf_static";
+    return std::nullopt;
+  }
+  try {
+    const geometry_msgs::TransformStamped t = buffer.lookupTransform(target, source, ros::Time(0));
+    const auto& q = t.transform.rotation;
+    return Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+  } catch (const tf2::TransformException& e) {
+    why = e.what();
+    return std::nullopt;
+  }
 }
 
 geometry_msgs::TransformStamped staticTransform(const std::string& parent, const std::string& child, double stamp,

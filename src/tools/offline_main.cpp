@@ -34,6 +34,7 @@
 #include "oefmt/io/fft_wisdom.h"
 #include "oefmt/io/nadir_view.h"
 #include "oefmt/io/vehicle_data.h"
+#include "oefmt/ros/bag_io.h"
 #include "oefmt/ros/vehicle_messages.h"
 #include "oefmt/io/run_setup.h"
 
@@ -70,8 +71,8 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
                  "CameraInfo topic (default: <image namespace>/camera_info if present;\n'-' ignores intrinsics)")
       ->type_name("T");
   app.add_option("--imu-topic", o.imu_topic,
-                 "sensor_msgs/Imu topic in the bag (its frame taken as the camera\nbody): levels the frames as a "
-                 "folder's imu.txt does")
+                 "sensor_msgs/Imu topic in the bag (the camera's mount in its frame\nfrom the bag's /tf_static): "
+                 "levels the frames as a folder's imu.txt does")
       ->type_name("T");
   app.add_option("--range-topic", o.range_topic,
                  "sensor_msgs/Range topic of a downward rangefinder in the bag: the\nscale, as a folder's range.txt")
@@ -159,6 +160,30 @@ std::vector<Sample> readVehicleData(const Options& o, const char* file_name, con
   return {};
 }
 
+// The camera's optical frame in the frame of a bag's IMU messages, from the bag's /tf_static; the
+// IMU's frame taken as the camera body (the camera looking down its -z) when the bag does not say.
+Eigen::Matrix3d cameraMountInImu(const Options& o, const std::string& imu_topic) {
+  const std::string imu_frame = oefmt::firstFrameId(o.bag, imu_topic);
+  oefmt::BagImageReader images(o.bag, o.image_topic, "-");
+  oefmt::BagFrame first;
+  const std::string camera_frame = images.next(first) ? first.frame_id : std::string();
+  std::string why;
+  const std::optional<Eigen::Quaterniond> mount = oefmt::staticRotation(o.bag, imu_frame, camera_frame, why);
+  if (mount) {
+    if (!o.quiet && imu_frame != camera_frame) {
+      std::fprintf(stderr, "oefmt_offline: camera mount from /tf_static: %s in the IMU's %s\n",
+                   camera_frame.c_str(), imu_frame.c_str());
+    }
+    return mount->toRotationMatrix();
+  }
+  std::fprintf(stderr,
+               "oefmt_offline: warning: no camera mount in the IMU's frame (%s -> %s: %s): the IMU's frame "
+               "is taken as the camera body (the camera looking down its -z, image right on its x)\n",
+               imu_frame.empty() ? "?" : imu_frame.c_str(), camera_frame.empty() ? "?" : camera_frame.c_str(),
+               why.c_str());
+  return oefmt::downLookingMount();
+}
+
 void writeDiagnosticsHeader(std::ostream& out) {
   out << "frame,stamp,state,degraded,theta_rad,zoom,phi_rad,rho_px,confidence,"
          "sigma_theta_rad,sigma_log_zoom,sigma_phi_rad,sigma_rho_px,"
@@ -241,9 +266,9 @@ int main(int argc, char** argv) {
         config.working_fx = undistorter->workingFx();
       }
     }
-    // Attitude-aided registration: a folder's imu.txt or a bag's --imu-topic (its frame is taken
-    // as the camera body) gives each frame's roll and pitch, with which the frame is turned into a
-    // level camera's view.
+    // Attitude-aided registration: a folder's imu.txt (of the camera body) or a bag's --imu-topic
+    // (the camera's mount in the IMU's frame from the bag's /tf_static) gives each frame's roll
+    // and pitch, with which the frame is turned into a level camera's view.
     std::string imu_source;
     const std::vector<oefmt::ImuSample> imu_samples =
         options.use_imu ? readVehicleData(options, oefmt::kImuFileName, options.imu_topic, &oefmt::readImuFile,
@@ -255,11 +280,13 @@ int main(int argc, char** argv) {
     }
     std::shared_ptr<oefmt::AttitudeHistory> attitudes;
     std::shared_ptr<const oefmt::NadirView> nadir;
+    Eigen::Matrix3d camera_in_imu = oefmt::downLookingMount();
     if (!imu_samples.empty()) {
       if (!undistorter) {
         std::fprintf(stderr, "oefmt_offline: warning: %s ignored: no intrinsics to level the frames with\n",
                      imu_source.c_str());
       } else {
+        if (!options.bag.empty()) camera_in_imu = cameraMountInImu(options, imu_source);
         attitudes = std::make_shared<oefmt::AttitudeHistory>();
         for (const oefmt::ImuSample& sample : imu_samples) attitudes->add(sample.stamp, sample.orientation);
         nadir = std::make_shared<const oefmt::NadirView>(undistorter->inputCamera(), image_size,
@@ -292,11 +319,10 @@ int main(int argc, char** argv) {
     const auto context = std::make_shared<const oefmt::SpectralContext>(config.registration);
     oefmt::PrefetchingSource source(
         std::move(opened), 2,
-        [builder = oefmt::SpectraBuilder(context), undistorter, attitudes, nadir,
+        [builder = oefmt::SpectraBuilder(context), undistorter, attitudes, nadir, camera_in_imu,
          unlevelled](oefmt::SourceFrame& frame) mutable {
           if (attitudes) {
-            // The IMU's body is the camera body: the optical frame is it turned about x.
-            frame.tilt = oefmt::cameraTiltAt(*attitudes, frame.stamp);
+            frame.tilt = oefmt::cameraTiltAt(*attitudes, frame.stamp, camera_in_imu);
             if (frame.tilt) {
               frame.spectra = builder.build(nadir->apply(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
               return;

@@ -294,6 +294,21 @@ Deterministic for a given seed. Defaults: the paper's circle (491 m, 200 frames,
       ->type_name("T")
       ->group(output);
   app.add_option("--frame-id", command.bag_options.frame_id, "(default camera_optical)")->type_name("F")->group(output);
+  app.add_option_function<std::vector<double>>(
+         "--imu-mount",
+         [&command](const std::vector<double>& rpy) {
+           // Rz(yaw) Ry(pitch) Rx(roll): the IMU frame in the body.
+           command.bag_options.imu_mount = Eigen::AngleAxisd(rpy[2] * kDeg, Eigen::Vector3d::UnitZ()) *
+                                           Eigen::AngleAxisd(rpy[1] * kDeg, Eigen::Vector3d::UnitY()) *
+                                           Eigen::AngleAxisd(rpy[0] * kDeg, Eigen::Vector3d::UnitX());
+         },
+         "the bag's IMU frame turned by roll,pitch,yaw in the body (its messages\nand /tf_static say so; "
+         "default 0,0,0)")
+      ->type_name("R,P,Y")
+      ->expected(3)
+      ->delimiter(',')
+      ->check(oefmt::tools::finite())
+      ->group(output);
   app.add_flag("--quiet", command.quiet, "print nothing but errors")->group(output);
 
   app.callback([&] {

@@ -481,6 +481,41 @@ TEST(Tools, OfflineLevelsTiltedFramesWithTheImuAndScalesWithTheRangefinder) {
   expectRefused("--images " + (dir / "flight"), "imu.txt' line ");
 }
 
+TEST(Tools, OfflineTakesTheCameraMountInTheImusFrameFromTheBagsTf) {
+  // One tilted flight, twice: the IMU aligned with the body, and mounted upside down and turned a
+  // quarter (its messages in its own frame, its mount on /tf_static). Levelled through the mount,
+  // both give the same trajectory; without /tf_static the turned IMU's tilt is another one.
+  TempDir dir;
+  const std::string simulate = std::string(OEFMT_SIMULATE) +
+                               " --quiet --size 256 --track line --frames 30 --length 45 --seed 8 --wobble 8 "
+                               "--wobble-hz 1 --imu ";
+  ASSERT_EQ(run(dir, simulate + "--bag " + (dir / "aligned.bag") + " " + (dir / "aligned")).status, 0);
+  const ToolRun turned =
+      run(dir, simulate + "--imu-mount 180,0,90 --bag " + (dir / "turned.bag") + " " + (dir / "turned"));
+  ASSERT_EQ(turned.status, 0) << turned.err;
+  std::ofstream(dir / "size256.yaml") << "registration:\n   size: 256\n";
+  const std::string offline = std::string(OEFMT_OFFLINE) + " --config " + (dir / "size256.yaml") +
+                              " --imu-topic /imu/data --bag ";
+  const ToolRun aligned = run(dir, offline + (dir / "aligned.bag") + " --output " + (dir / "aligned.tum"));
+  ASSERT_EQ(aligned.status, 0) << aligned.err;
+  const ToolRun mounted = run(dir, offline + (dir / "turned.bag") + " --output " + (dir / "turned.tum"));
+  ASSERT_EQ(mounted.status, 0) << mounted.err;
+  EXPECT_NE(mounted.err.find("camera mount from /tf_static: camera_optical in the IMU's imu_link"), std::string::npos)
+      << mounted.err;
+  EXPECT_LT(largestDifference(poses(dir / "aligned.tum"), poses(dir / "turned.tum")), 1e-6);
+  // The same bag without its /tf_static: said, and the frames levelled with a wrong tilt.
+  ASSERT_EQ(run(dir, "rosbag filter " + (dir / "turned.bag") + " " + (dir / "untold.bag") +
+                         " \"topic != '/tf_static'\"").status,
+            0);
+  const ToolRun untold = run(dir, offline + (dir / "untold.bag") + " --output " + (dir / "untold.tum"));
+  ASSERT_EQ(untold.status, 0) << untold.err;
+  EXPECT_NE(untold.err.find("no camera mount in the IMU's frame (imu_link -> camera_optical: the bag has no "
+                            "/tf_static): the IMU's frame is taken as the camera body"),
+            std::string::npos)
+      << untold.err;
+  EXPECT_GT(largestDifference(poses(dir / "aligned.tum"), poses(dir / "untold.tum")), 0.05);
+}
+
 TEST(Tools, MeasureSpeedReportsEveryRun) {
   TempDir dir;
   ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));

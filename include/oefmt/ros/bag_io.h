@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -107,6 +108,9 @@ struct BagWriterOptions {
   std::string base_frame = "base_link";
   std::string imu_frame = "imu_link";
   std::string range_frame = "rangefinder";
+  /// The IMU frame's orientation in the body (base_frame): writeImu() gives the IMU's own
+  /// orientation, angular velocity and specific force, writeMounts() this mount.
+  Eigen::Quaterniond imu_mount = Eigen::Quaterniond::Identity();
 };
 
 /// Writes images and their CameraInfo (same stamp) to a new bag.
@@ -120,12 +124,12 @@ class BagFlightWriter {
 
   /// stamp > 0 [s]. Throws BagError for an unsupported image type or a write failure.
   void write(const cv::Mat& image, double stamp);
-  /// A sensor_msgs/Imu on imu_topic (frame imu_frame) and a sensor_msgs/Range on range_topic
+  /// A sensor_msgs/Imu on imu_topic (frame imu_frame; `sample` is the body's) and a sensor_msgs/Range on range_topic
   /// (frame range_frame). Throws BagError for a write failure.
   void writeImu(const ImuSample& sample);
   void writeRange(const RangeSample& sample);
   /// /tf_static at `stamp`: base -> camera (frame_id; looking down the body's -z, image right on
-  /// the body's x), base -> IMU (aligned), base -> rangefinder (its x axis down the body's -z).
+  /// the body's x), base -> IMU (imu_mount), base -> rangefinder (its x axis down the body's -z).
   void writeMounts(double stamp);
   /// Closes the bag (also done by the destructor). Throws BagError on failure.
   void close();

@@ -3,8 +3,11 @@
 // REP-117 for readings without return), read from and written to bags.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/Imu.h>
@@ -38,6 +41,16 @@ RangeSample rangeSample(const sensor_msgs::Range& message);
 /// Throws BagError naming the bag and topic when it cannot be read or a topic holds another type.
 std::vector<ImuSample> readImuTopic(const std::string& bag_path, const std::string& topic);
 std::vector<RangeSample> readRangeTopic(const std::string& bag_path, const std::string& topic);
+
+/// The frame id of the first sensor_msgs/Imu, Image, CompressedImage or Range message on `topic`
+/// of a bag; empty when it has none. Throws BagError when the bag cannot be read.
+std::string firstFrameId(const std::string& bag_path, const std::string& topic);
+
+/// The rotation of frame `source` in frame `target` (target <- source) from a bag's /tf_static,
+/// chained through their common frames; nothing when those transforms do not connect them
+/// (`why` then says what is missing). Throws BagError when the bag cannot be read.
+std::optional<Eigen::Quaterniond> staticRotation(const std::string& bag_path, const std::string& target,
+                                                 const std::string& source, std::string& why);
 
 /// A static transform parent -> child (rotation as a quaternion x, y, z, w).
 geometry_msgs::TransformStamped staticTransform(const std::string& parent, const std::string& child, double stamp,
