@@ -86,4 +86,48 @@ void AttitudeHistory::forgetBefore(double stamp) {
   while (samples_.size() > 1 && samples_[1].stamp <= stamp) samples_.pop_front();
 }
 
+TurnHistory::TurnHistory(double max_gap) : max_gap_(max_gap) {}
+
+bool TurnHistory::add(double stamp, const Eigen::Quaterniond& body_to_world, const Eigen::Vector3d& angular_velocity) {
+  if (!std::isfinite(stamp) || (!samples_.empty() && !(stamp > samples_.back().stamp))) return false;
+  // The yaw's rate (yaw, pitch, roll about z, y', x''), the one angle the level view keeps: from
+  // the body rates p, q, r, yaw' = (q sin roll + r cos roll) / cos pitch. (The world's vertical
+  // rate is not it: a roll while pitched turns about it without changing the yaw.)
+  const Eigen::Matrix3d r = body_to_world.normalized().toRotationMatrix();
+  const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
+  const double roll = std::atan2(r(2, 1), r(2, 2));
+  const double rate = (angular_velocity.y() * std::sin(roll) + angular_velocity.z() * std::cos(roll)) /
+                      std::max(std::cos(pitch), 1e-6);
+  if (!std::isfinite(rate)) return false;
+  samples_.push_back({stamp, rate});
+  return true;
+}
+
+std::optional<double> TurnHistory::turn(double from, double to) const {
+  if (!(to >= from) || samples_.empty() || samples_.front().stamp > from || samples_.back().stamp < to) {
+    return std::nullopt;
+  }
+  // The rate at t on the segment a-b, linearly.
+  const auto rateAt = [](const Sample& a, const Sample& b, double t) {
+    const double span = b.stamp - a.stamp;
+    return span > 0.0 ? a.rate + (b.rate - a.rate) * (t - a.stamp) / span : a.rate;
+  };
+  if (samples_.size() == 1) return from == to ? std::optional<double>(0.0) : std::nullopt;
+  double turned = 0.0;
+  for (std::size_t k = 1; k < samples_.size(); ++k) {
+    const Sample& a = samples_[k - 1];
+    const Sample& b = samples_[k];
+    if (b.stamp <= from) continue;
+    if (a.stamp >= to) break;
+    if (b.stamp - a.stamp > max_gap_) return std::nullopt;
+    const double t0 = std::max(a.stamp, from), t1 = std::min(b.stamp, to);
+    turned += 0.5 * (rateAt(a, b, t0) + rateAt(a, b, t1)) * (t1 - t0);
+  }
+  return turned;
+}
+
+void TurnHistory::forgetBefore(double stamp) {
+  while (samples_.size() > 1 && samples_[1].stamp <= stamp) samples_.pop_front();
+}
+
 }  // namespace oefmt

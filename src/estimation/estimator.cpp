@@ -136,6 +136,8 @@ struct Estimator::State {
   // `intervals` frame intervals and `seconds` after frame 1, starting from `start` (pair 0-1
   // for pair 0-2); none without a motion or outside oefmt mode.
   std::optional<RegistrationPrior> predictedPair(int intervals, double seconds, const PairMotion* start) const;
+  // A rotation measured otherwise (a gyro's) with its sigma in place of the prediction's.
+  void takeTurn(RegistrationPrior& prior, double rotation, double sigma) const;
 
   const EstimatorConfig& config;
   Registrar registrar;
@@ -275,6 +277,14 @@ std::optional<RegistrationPrior> Estimator::State::predictedPair(int intervals, 
                                3.0 * uncertainty + kTranslationWindowFloor;
   }
   return prior;
+}
+
+void Estimator::State::takeTurn(RegistrationPrior& prior, double rotation, double sigma) const {
+  const double rotation_bins = kPriorWindowBins * CV_PI / config.registration.size;
+  prior.rotation = rotation;
+  prior.rotation_window = rotation_bins + 3.0 * sigma;
+  prior.rotation_spread = std::hypot(sigma, rotation_bins / 3.0);
+  prior.rotation_sigma = std::hypot(sigma, rotation_bins / 3.0);
 }
 
 bool Estimator::State::shiftInReach(const cv::Point2d& followed) const {
@@ -574,6 +584,11 @@ Estimator::~Estimator() = default;
 void Estimator::reset() {
   state_->clear();
   frame_count_ = 0;
+  turn_.reset();
+}
+
+void Estimator::setTurn(double turn, double sigma) {
+  if (std::isfinite(turn) && std::isfinite(sigma) && sigma >= 0.0) turn_ = std::make_pair(turn, sigma);
 }
 
 const Pose4& Estimator::pose() const { return state_->integrator.pose(); }
@@ -635,6 +650,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
   const bool textured = std::isfinite(spectra.texture) &&
                         spectra.texture >= config_.registration.min_texture;
   WindowFrame frame{std::move(spectra), est.frame_index, stamp};
+  const std::optional<std::pair<double, double>> turn = std::exchange(turn_, std::nullopt);  // this frame's only
 
   if (!s.f1) {
     s.anchorFrame(std::move(frame), textured, est);
@@ -648,6 +664,11 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
                         s.shiftInReach(s.motion01.translation * (double(s.gap01 + est.frame_gap) / s.gap01));
     s.prior02 = with02 ? s.predictedPair(est.frame_gap, seconds12, &s.motion01) : std::nullopt;
+    // A gyro's turn stands for the predicted rotation (the image turns against the camera).
+    if (turn && s.prior02) {
+      s.takeTurn(*s.prior02, s.motion01.rotation - turn->first,
+                 std::hypot(turn->second, s.motion01.rotation_sigma));
+    }
     if (with02 && config_.parallel_registrations) {
       // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
       // cached spectra; each Registrar has its own scratch). Collected in oefmtStep; discarded
@@ -663,6 +684,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
+    if (turn && s.prior12) s.takeTurn(*s.prior12, -turn->first, turn->second);
     est.prediction12 = s.prior12;
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
                                                   s.prior12 ? &*s.prior12 : nullptr);

@@ -190,6 +190,8 @@ void OdometryRos::imuCallback(const sensor_msgs::ImuConstPtr& message) {
   const ImuSample sample = imuSample(*message);
   std::lock_guard<std::mutex> lock(vehicle_mutex_);
   imu_frame_ = message->header.frame_id;
+  if (recent_imu_.empty() || sample.stamp > recent_imu_.back().stamp) recent_imu_.push_back(sample);
+  while (!recent_imu_.empty() && recent_imu_.front().stamp < sample.stamp - 10.0) recent_imu_.pop_front();
   attitudes_.add(sample.stamp, sample.orientation);
   attitudes_.forgetBefore(sample.stamp - 10.0);  // frames older than that are long processed
   const double roll = message->orientation_covariance[0], pitch = message->orientation_covariance[4];
@@ -211,6 +213,27 @@ const Eigen::Matrix3d& OdometryRos::imuMount(const std::string& imu_frame) {
                           << "): the IMU's frame is taken as " << parameters_.base_frame);
   }
   return imu_mount_;
+}
+
+std::optional<double> OdometryRos::gyroTurn(double from, double to) {
+  std::vector<ImuSample> samples;
+  std::string imu_frame;
+  {
+    std::lock_guard<std::mutex> lock(vehicle_mutex_);
+    imu_frame = imu_frame_;
+    for (const ImuSample& s : recent_imu_) {
+      if (s.stamp >= from - parameters_.imu_timeout && s.stamp <= to + parameters_.imu_timeout) samples.push_back(s);
+    }
+  }
+  if (samples.empty()) return std::nullopt;
+  // The camera body's yaw (the level view keeps it): the IMU's samples turned into it.
+  const Eigen::Matrix3d imu_from_camera = imuMount(imu_frame).transpose() * mount_ * downLookingMount().transpose();
+  const Eigen::Quaterniond camera(imu_from_camera);
+  TurnHistory turns(parameters_.imu_timeout);
+  for (const ImuSample& s : samples) {
+    turns.add(s.stamp, s.orientation * camera, imu_from_camera.transpose() * s.angular_velocity);
+  }
+  return turns.turn(from, to);
 }
 
 std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
@@ -284,6 +307,7 @@ void OdometryRos::resetEstimator(const std::string& why) {
   input_size_ = cv::Size();
   nadir_.reset();
   range_altitude_ = RangeAltitude();
+  previous_stamp_ = -1.0;
   scale_votes_.clear();
   scale_frames_ = 0;
   scale_settled_ = false;
@@ -366,6 +390,7 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     }
     config.initial_altitude = chooseInitialAltitude(altitude_topic, config.initial_altitude);
     estimator_ = std::make_unique<Estimator>(config);
+    previous_stamp_ = -1.0;
     lookUpCameraMount(frame);
     if (parameters_.use_imu) {
       nadir_ = std::make_unique<const NadirView>(undistorter_->inputCamera(), image.size(), working_fx,
@@ -443,8 +468,15 @@ void OdometryRos::process(const InputFrame& frame) {
   // Correlation surfaces cost copies: only while someone watches them.
   estimator_->setKeepSurfaces(rotation_zoom_publisher_.getNumSubscribers() > 0 ||
                               translation_publisher_.getNumSubscribers() > 0);
+  // The gyro's turn since the previous frame: the rotation the registration searches around.
+  if (parameters_.use_imu && previous_stamp_ >= 0.0) {
+    if (const std::optional<double> turn = gyroTurn(previous_stamp_, frame.stamp.toSec())) {
+      estimator_->setTurn(*turn, kGyroRateError * (frame.stamp.toSec() - previous_stamp_));
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
   const std::optional<Estimate> estimate = estimator_->push(image, frame.stamp.toSec());
+  if (estimate) previous_stamp_ = frame.stamp.toSec();
   last_processing_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (!estimate) return;

@@ -281,6 +281,7 @@ int main(int argc, char** argv) {
     std::shared_ptr<oefmt::AttitudeHistory> attitudes;
     std::shared_ptr<const oefmt::NadirView> nadir;
     Eigen::Matrix3d camera_in_imu = oefmt::downLookingMount();
+    std::optional<oefmt::TurnHistory> turns;
     if (!imu_samples.empty()) {
       if (!undistorter) {
         std::fprintf(stderr, "oefmt_offline: warning: %s ignored: no intrinsics to level the frames with\n",
@@ -288,7 +289,16 @@ int main(int argc, char** argv) {
       } else {
         if (!options.bag.empty()) camera_in_imu = cameraMountInImu(options, imu_source);
         attitudes = std::make_shared<oefmt::AttitudeHistory>();
-        for (const oefmt::ImuSample& sample : imu_samples) attitudes->add(sample.stamp, sample.orientation);
+        // The camera body's yaw (the level view keeps it): the IMU's orientation and rates turned
+        // into the camera body (the optical frame with y and z flipped).
+        turns.emplace();
+        const Eigen::Matrix3d imu_from_camera_body = camera_in_imu * oefmt::downLookingMount().transpose();
+        const Eigen::Quaterniond camera_body(imu_from_camera_body);
+        for (const oefmt::ImuSample& sample : imu_samples) {
+          attitudes->add(sample.stamp, sample.orientation);
+          turns->add(sample.stamp, sample.orientation * camera_body,
+                     imu_from_camera_body.transpose() * sample.angular_velocity);
+        }
         nadir = std::make_shared<const oefmt::NadirView>(undistorter->inputCamera(), image_size,
                                                           config.working_fx, config.registration.size);
         if (!options.quiet) {
@@ -407,6 +417,12 @@ int main(int argc, char** argv) {
         const std::string upscaling = oefmt::upscalingWarning(frame.image_size, config.registration.size);
         if (!upscaling.empty()) std::fprintf(stderr, "oefmt_offline: warning: %s\n", upscaling.c_str());
         first_stamp = frame.stamp;
+      }
+      // The gyro's turn since the previous frame: the rotation the registration searches around.
+      if (turns && estimator->frameCount() > 0) {
+        if (const std::optional<double> turn = turns->turn(last_stamp, frame.stamp)) {
+          estimator->setTurn(*turn, oefmt::kGyroRateError * (frame.stamp - last_stamp));
+        }
       }
       std::optional<oefmt::Estimate> estimate;
       try {

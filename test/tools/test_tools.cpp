@@ -482,13 +482,14 @@ TEST(Tools, OfflineLevelsTiltedFramesWithTheImuAndScalesWithTheRangefinder) {
 }
 
 TEST(Tools, OfflineTakesTheCameraMountInTheImusFrameFromTheBagsTf) {
-  // One tilted flight, twice: the IMU aligned with the body, and mounted upside down and turned a
-  // quarter (its messages in its own frame, its mount on /tf_static). Levelled through the mount,
-  // both give the same trajectory; without /tf_static the turned IMU's tilt is another one.
+  // One tilted flight turning with its track, twice: the IMU aligned with the body, and mounted
+  // upside down and turned a quarter (its messages in its own frame, its mount on /tf_static).
+  // Levelled through the mount, both give the same trajectory; without /tf_static the turned
+  // IMU's tilt and turn are other ones.
   TempDir dir;
   const std::string simulate = std::string(OEFMT_SIMULATE) +
-                               " --quiet --size 256 --track line --frames 30 --length 45 --seed 8 --wobble 8 "
-                               "--wobble-hz 1 --imu ";
+                               " --quiet --size 256 --track circle --heading track --frames 30 --length 74 --seed 8 "
+                               "--tilt --wobble 8 --wobble-hz 1 --imu ";
   ASSERT_EQ(run(dir, simulate + "--bag " + (dir / "aligned.bag") + " " + (dir / "aligned")).status, 0);
   const ToolRun turned =
       run(dir, simulate + "--imu-mount 180,0,90 --bag " + (dir / "turned.bag") + " " + (dir / "turned"));
@@ -503,6 +504,14 @@ TEST(Tools, OfflineTakesTheCameraMountInTheImusFrameFromTheBagsTf) {
   EXPECT_NE(mounted.err.find("camera mount from /tf_static: camera_optical in the IMU's imu_link"), std::string::npos)
       << mounted.err;
   EXPECT_LT(largestDifference(poses(dir / "aligned.tum"), poses(dir / "turned.tum")), 1e-6);
+  // Levelled, and turning with the track (the gyro's turn is each pair's predicted rotation):
+  // accurate against the ground truth.
+  const ToolRun evaluate = run(dir, std::string(OEFMT_EVALUATE) + " --json-only " + (dir / "turned.tum") + " " +
+                                        (dir / "turned/groundtruth.tum"));
+  ASSERT_EQ(evaluate.status, 0) << evaluate.err;
+  const auto rmse = evaluate.out.find("\"rmse\":");
+  ASSERT_NE(rmse, std::string::npos) << evaluate.out;
+  EXPECT_LT(std::stod(evaluate.out.substr(rmse + 7)), 0.3) << evaluate.out;
   // The same bag without its /tf_static: said, and the frames levelled with a wrong tilt.
   ASSERT_EQ(run(dir, "rosbag filter " + (dir / "turned.bag") + " " + (dir / "untold.bag") +
                          " \"topic != '/tf_static'\"").status,

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "oefmt/estimation/attitude.h"
+#include "oefmt/estimation/estimator.h"
 #include "oefmt/io/nadir_view.h"
 #include "oefmt/registration/registration.h"
 #include "oefmt/sim/flight.h"
@@ -127,6 +128,101 @@ TEST(AttitudeAidedRegistration, PureRollOrPitchRegistersAsNoTranslation) {
     EXPECT_NEAR(aided.rotation, 0.0, 0.2 * kDeg);
     EXPECT_NEAR(aided.zoom, 1.0, 0.003);
   }
+}
+
+TEST(Attitude, TurnHistoryIntegratesTheYawRateNotTheVerticalRate) {
+  // A body pitched 10 degrees that rolls at 0.5 rad/s keeps its yaw: about the world's vertical it
+  // turns (by -0.5 sin 10 deg per second), about its yaw it does not. Then it yaws at 0.3 rad/s.
+  TurnHistory turns(0.1);
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 0.005 * k;
+    const double roll = 0.5 * t;
+    const Eigen::Quaterniond body(Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(10.0 * kDeg, Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()));
+    // Body rates of a roll rate alone: p = roll rate.
+    ASSERT_TRUE(turns.add(t, body, Eigen::Vector3d(0.5, 0.0, 0.0)));
+  }
+  ASSERT_TRUE(turns.turn(0.1, 0.9).has_value());
+  EXPECT_NEAR(*turns.turn(0.1, 0.9), 0.0, 1e-9);
+  TurnHistory yawing(0.1);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.01 * k;
+    const Eigen::Quaterniond body(Eigen::AngleAxisd(0.3 * t, Eigen::Vector3d::UnitZ()));
+    yawing.add(t, body, Eigen::Vector3d(0.0, 0.0, 0.3));
+  }
+  EXPECT_NEAR(*yawing.turn(0.205, 0.705), 0.15, 1e-9);  // ends between samples
+  EXPECT_FALSE(yawing.turn(0.5, 1.2).has_value());       // beyond the samples
+  EXPECT_FALSE(yawing.turn(-0.1, 0.5).has_value());
+  TurnHistory gap(0.1);
+  gap.add(0.0, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  gap.add(0.5, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  EXPECT_FALSE(gap.turn(0.1, 0.2).has_value());  // nothing is known inside a gap
+}
+
+TEST(AttitudeAidedRegistration, AGyrosTurnLetsASuddenYawRegister) {
+  // A vehicle flies straight, then yaws 25 degrees between two frames (125 deg/s). The motion so
+  // far predicts no turn and searches the rotation near it: the turn is refused as implausible.
+  // With the gyro's turn the rotation is searched where it is, and the frame registers.
+  constexpr int kN = 256;
+  constexpr int kTurnFrame = 8;
+  constexpr double kTurn = 25.0 * kDeg;
+  sim::FlightOptions options;
+  options.width = options.height = kN;
+  options.flat = true;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.frames = 12;
+  options.track.length = 12.0;
+  options.track.altitude = 12.0;
+  options.seed = 4;
+  sim::FlightPlan plan = sim::planFlight(options);
+  for (int k = kTurnFrame; k < static_cast<int>(plan.poses.size()); ++k) plan.poses[k].yaw += kTurn;
+  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
+  const sim::Renderer renderer(scene, plan.camera, 2);
+  std::vector<cv::Mat1f> frames;
+  for (const sim::FlightPose& pose : plan.poses) frames.push_back(renderer.render(pose).image);
+
+  const auto fly = [&](bool gyro) {
+    EstimatorConfig config;
+    config.registration.size = kN;
+    config.registration.fft_planning = FftPlanning::kEstimate;
+    config.working_fx = plan.camera.intrinsics.fx;
+    Estimator estimator(config);
+    std::vector<Estimate> estimates;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      if (gyro && k > 0) {
+        // A gyro whose turn is 1 degree short at the sudden yaw.
+        const double turn = plan.poses[k].yaw - plan.poses[k - 1].yaw;
+        estimator.setTurn(static_cast<int>(k) == kTurnFrame ? turn - 1.0 * kDeg : turn, kGyroRateError * 0.2);
+      }
+      const std::optional<Estimate> e = estimator.push(frames[k], 0.2 * static_cast<double>(k));
+      EXPECT_TRUE(e.has_value());
+      if (e) estimates.push_back(*e);
+    }
+    return estimates;
+  };
+  const std::vector<Estimate> without = fly(false);
+  const std::vector<Estimate> with = fly(true);
+  ASSERT_EQ(without.size(), frames.size());
+  ASSERT_EQ(with.size(), frames.size());
+  const auto yawStep = [](const std::vector<Estimate>& e, int k) {
+    return std::remainder(e[k].pose.yaw - e[k - 1].pose.yaw, 2.0 * M_PI);
+  };
+  // Straight flight before: both track it.
+  for (int k = 1; k < kTurnFrame; ++k) {
+    EXPECT_EQ(without[k].state, TrackingState::kTracking) << k;
+    EXPECT_EQ(with[k].state, TrackingState::kTracking) << k;
+  }
+  // The turn: the motion model alone does not take it; with the gyro it is measured.
+  EXPECT_TRUE(without[kTurnFrame].state != TrackingState::kTracking ||
+              std::fabs(std::fabs(yawStep(without, kTurnFrame)) - kTurn) > 2.0 * kDeg)
+      << "without the gyro: " << toString(without[kTurnFrame].state) << ", yaw step "
+      << yawStep(without, kTurnFrame) / kDeg << " deg";
+  EXPECT_EQ(with[kTurnFrame].state, TrackingState::kTracking);
+  EXPECT_NEAR(std::fabs(yawStep(with, kTurnFrame)), kTurn, 0.5 * kDeg);
+  // The image's rotation is measured, not copied from the gyro: the turn the gyro got 1 degree
+  // short registers at the true one (the window holds both).
+  EXPECT_NEAR(std::fabs(with[kTurnFrame].registration12.rotation), kTurn, 0.5 * kDeg);
 }
 
 }  // namespace

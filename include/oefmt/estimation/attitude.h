@@ -82,4 +82,39 @@ class AttitudeHistory {
   std::deque<Sample> samples_;
 };
 
+/// How far a MEMS gyro's rate may be off, bias and noise together [rad/s] (about 0.6 deg/s: an
+/// uncalibrated consumer gyro's bias): the uncertainty of a turn integrated from it is this times
+/// the interval.
+inline constexpr double kGyroRateError = 0.01;
+
+/// A body's yaw turn over time, from its gyro: the rate of the yaw (of yaw, pitch, roll about z,
+/// y', x'') from the angular velocity (body frame) and the orientation, integrated. For the camera
+/// body of frames levelled to look straight down (the level view keeps the yaw), the turn between
+/// two frames, which the gyro measures far better than the images' motion so far predicts it (a
+/// sudden yaw, a texture that matches itself turned).
+class TurnHistory {
+ public:
+  /// max_gap: samples further apart than this [s] do not cover the time between them.
+  explicit TurnHistory(double max_gap = 0.1);
+
+  /// Adds a sample; one not after the newest is ignored (returns false).
+  bool add(double stamp, const Eigen::Quaterniond& body_to_world, const Eigen::Vector3d& angular_velocity);
+  /// The turn from `from` to `to` [rad, counter-clockwise seen from above]: the yaw rate
+  /// integrated by trapezoids, linearly interpolated at both ends; nothing unless the samples
+  /// cover [from, to] without a gap longer than max_gap.
+  std::optional<double> turn(double from, double to) const;
+  /// Drops samples no longer needed for turns from `stamp` on.
+  void forgetBefore(double stamp);
+
+  bool empty() const { return samples_.empty(); }
+
+ private:
+  struct Sample {
+    double stamp;
+    double rate;  // of the yaw [rad/s]
+  };
+  double max_gap_;
+  std::deque<Sample> samples_;
+};
+
 }  // namespace oefmt

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -142,6 +143,13 @@ class Estimator {
   /// The altitude above the reference plane now (output units).
   double altitude() const;
 
+  /// The camera's turn about the vertical from the previous frame to the next one pushed, as a
+  /// gyro measured it [rad, counter-clockwise seen from above], and its standard deviation: in
+  /// the oefmt mode, once the motion so far predicts the pairs, it stands for the predicted
+  /// rotation of pair 1-2 (and of 0-2 with pair 0-1's), which is searched within its window.
+  /// For the next push only.
+  void setTurn(double turn, double sigma);
+
   /// Copy pair 1-2's correlation surfaces into every Estimate (costs copies; for debug views).
   void setKeepSurfaces(bool keep) { keep_surfaces_ = keep; }
 
@@ -161,6 +169,7 @@ class Estimator {
   EstimatorConfig config_;
   std::size_t frame_count_ = 0;
   bool keep_surfaces_ = false;
+  std::optional<std::pair<double, double>> turn_;  // setTurn's, for the next push
   std::unique_ptr<State> state_;
 };
 

@@ -73,6 +73,8 @@ class OdometryRos {
   std::optional<CameraTilt> tiltAt(const InputFrame& frame);
   /// The IMU frame's rotation in base_frame (TF; the identity, said once, without one).
   const Eigen::Matrix3d& imuMount(const std::string& imu_frame);
+  /// The camera's yaw turn from `from` to `to` by the IMU's gyro (nothing without its samples).
+  std::optional<double> gyroTurn(double from, double to);
   /// The rangefinder's reading at the frame, vertical (nothing without one near the stamp).
   std::optional<double> verticalRangeAt(const InputFrame& frame, const std::optional<CameraTilt>& tilt);
   bool resetService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
@@ -137,6 +139,8 @@ class OdometryRos {
   long unlevelled_ = 0;                          ///< frames taken as level for want of an attitude
   bool frame_unlevelled_ = false;  ///< the current frame: taken as level although the IMU had spoken
   std::string imu_frame_;           ///< the IMU messages' frame id
+  std::deque<ImuSample> recent_imu_;  ///< the IMU's last samples, for the gyro's turns
+  double previous_stamp_ = -1.0;      ///< of the frame last given to the estimator
   std::string imu_mount_frame_;     ///< the frame imu_mount_ was looked up for
   Eigen::Matrix3d imu_mount_ = Eigen::Matrix3d::Identity();  ///< the IMU's frame in base_frame, from TF
   double largest_tilt_ = 0.0;      ///< base_frame's largest tilt the IMU gave at a frame [rad]
