@@ -577,11 +577,7 @@ void OdometryRos::publish(const InputFrame& frame, const Estimate& estimate) {
     stamped.pose.position.x = pose.x;
     stamped.pose.position.y = pose.y;
     stamped.pose.position.z = pose.z;
-    const auto q = yawQuaternion(pose.yaw);
-    stamped.pose.orientation.x = q[0];
-    stamped.pose.orientation.y = q[1];
-    stamped.pose.orientation.z = q[2];
-    stamped.pose.orientation.w = q[3];
+    stamped.pose.orientation = odometry.pose.pose.orientation;  // with the IMU's roll and pitch
     path_.header = header;
     path_.poses.push_back(stamped);
     if (static_cast<int>(path_.poses.size()) > parameters_.path_length) {
