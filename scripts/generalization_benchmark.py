@@ -52,6 +52,8 @@ def flight(name, what, *options, spin=False):
 # random brightness change of +-10 % between frames.
 LOW_TEXTURE = ["--contrast", "10", "--noise-grey", "5", "--flicker", "0.1"]
 DISTORTION = ["--k1", "-0.2", "--k2", "0.05"]
+# Tilt toward the track's acceleration plus an 8 degree wobble at 1 Hz, and an IMU.
+TILTED = ["--tilt", "--wobble", "8", "--wobble-hz", "1", "--imu"]
 CORPUS = [
     # Tracks and seeds on the default scene (ground and three levels of tops at 15-30 % of
     # the altitude, one inclined), 78 % overlap.
@@ -111,6 +113,13 @@ CORPUS = [
            *DISTORTION, "--heading", "track", "--seed", "27"),
     flight("line-distorted-brick", "line, distorted lens, brick tops", "--track", "line", *DISTORTION,
            "--texture-style", "cells,brick", "--seed", "28"),
+    # A multirotor without gimbal: leaning into its acceleration, with a wobble, and an IMU whose
+    # attitude wanders (imu.txt: oefmt_offline levels every frame with it).
+    flight("circle-tilted", "tilting multirotor, IMU", *TILTED, "--seed", "35"),
+    flight("eight-tilted-climb", "figure-8, tilting, climbing 8 m and back, IMU", "--track", "eight",
+           "--climb", "8", *TILTED, "--seed", "36"),
+    flight("line-tilted-climb", "line climbing 5 m, tilting, heading on the track, IMU", "--track", "line",
+           "--climb", "5", "--heading", "track", *TILTED, "--seed", "37"),
 ]
 
 # A few minutes: what the test command runs and asserts on.

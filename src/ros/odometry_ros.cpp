@@ -264,6 +264,7 @@ std::optional<CameraTilt> OdometryRos::tiltAt(const InputFrame& frame) {
   // camera's by its mount.
   const Eigen::Matrix3d base = body->toRotationMatrix() * imuMount(imu_frame).transpose();
   body_tilt_ = cameraTilt(base * downLookingMount());
+  ++levelled_;
   largest_tilt_ = std::max(largest_tilt_, tiltAngle(*body_tilt_));
   return cameraTilt(base * mount_);
 }
@@ -390,6 +391,10 @@ bool OdometryRos::prepareEstimator(const InputFrame& frame, const cv::Mat& image
     }
     config.initial_altitude = chooseInitialAltitude(altitude_topic, config.initial_altitude);
     estimator_ = std::make_unique<Estimator>(config);
+    scale_source_ = altitude_topic ? (parameters_.use_range ? "rangefinder (altitude topic), every reading"
+                                                            : "rangefinder (altitude topic), its first reading")
+                    : config.initial_altitude > 0.0 ? "~initial_altitude"
+                                                    : "none: units of the initial altitude";
     previous_stamp_ = -1.0;
     lookUpCameraMount(frame);
     if (parameters_.use_imu) {
@@ -659,6 +664,9 @@ void OdometryRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) 
   }
   status.add("registration confidence", last_confidence_.load());
   status.add("mode", toString(estimator_config_.mode));
+  status.add("scale source", scale_source_.load());
+  status.add("frames levelled with the IMU", levelled_.load());
+  status.add("frames taken as level (IMU stale)", unlevelled_.load());
   if (!problem.empty()) status.add("last problem", problem);
 }
 

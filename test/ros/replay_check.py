@@ -363,6 +363,12 @@ class ReplayCheck(unittest.TestCase):
                       values.get("frames dropped (newest wins)"),
                       "subscribed" if self.debug_subscribed else "not subscribed")
         self.assertEqual(values.get("frames dropped (newest wins)"), "0")
+        # Which scale the odometry has, and whether the IMU levelled the frames.
+        self.assertIn("scale source", values)
+        if self.expect_tilt:
+            self.assertGreater(int(values.get("frames levelled with the IMU", "0")), 0, values)
+        if self.imu_gap is not None:
+            self.assertGreater(int(values.get("frames taken as level (IMU stale)", "0")), 0, values)
 
     def test_accuracy_against_ground_truth(self):
         estimate = os.path.join(self.workdir, "node.tum")

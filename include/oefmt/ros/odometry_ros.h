@@ -136,7 +136,10 @@ class OdometryRos {
   int scale_frames_ = 0;
   bool scale_settled_ = false;
   std::optional<CameraTilt> body_tilt_;          ///< base_frame's roll and pitch at the last frame
-  long unlevelled_ = 0;                          ///< frames taken as level for want of an attitude
+  std::atomic<long> unlevelled_{0};              ///< frames taken as level for want of an attitude
+  std::atomic<long> levelled_{0};                ///< frames levelled with the IMU's attitude
+  /// Where the scale comes from, for the diagnostics (set when the estimator is made).
+  std::atomic<const char*> scale_source_{"none yet (no odometry)"};
   bool frame_unlevelled_ = false;  ///< the current frame: taken as level although the IMU had spoken
   std::string imu_frame_;           ///< the IMU messages' frame id
   std::deque<ImuSample> recent_imu_;  ///< the IMU's last samples, for the gyro's turns
