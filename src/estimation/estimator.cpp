@@ -607,6 +607,13 @@ void Estimator::observeAltitude(double altitude, double sigma, double drift_vari
   // Predictions made while frames failed are undone from the anchor: it moves alike.
   if (s.anchor) s.anchor->z += s.integrator.pose().z - before;
 }
+void Estimator::rescale(double factor) {
+  if (!std::isfinite(factor) || !(factor > 0.0)) return;
+  State& s = *state_;
+  s.integrator.rescale(factor);
+  if (s.anchor) *s.anchor = rescaled(*s.anchor, factor);
+}
+
 double Estimator::shiftPerBin() const { return state_->registrar.shiftPerBin(); }
 double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
 

@@ -127,6 +127,28 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
   return pose_;
 }
 
+void PoseIntegrator::rescale(double factor) {
+  if (!std::isfinite(factor) || !(factor > 0.0)) return;
+  initial_altitude_ *= factor;
+  pose_ = rescaled(pose_, factor);
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      last_step_covariance_(r, c) *= (r < 3 ? factor : 1.0) * (c < 3 ? factor : 1.0);
+    }
+  }
+}
+
+Pose4 rescaled(const Pose4& pose, double factor) {
+  Pose4 out = pose;
+  out.x *= factor;
+  out.y *= factor;
+  out.z *= factor;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) out.covariance(r, c) *= (r < 3 ? factor : 1.0) * (c < 3 ? factor : 1.0);
+  }
+  return out;
+}
+
 const Pose4& PoseIntegrator::hold(double stamp, const cv::Matx44d& extra_covariance) {
   pose_.stamp = stamp;
   pose_.covariance += extra_covariance;

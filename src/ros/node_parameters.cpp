@@ -45,9 +45,9 @@ ParameterTable nodeParameters(RosParameters& p) {
                       "taken as level, with a warning"),
       booleanParameter("use_range", p.use_range,
                        "keep the scale metric with every valid range of the altitude topic (a downward "
-                       "rangefinder, sensor_msgs/Range): the first 20 frames' readings settle which depth "
-                       "layer they saw, later ones correct the altitude; experimental in the node (on a "
-                       "short tilted replay it made the error worse, oefmt_offline's look-ahead does not)"),
+                       "rangefinder, sensor_msgs/Range) whenever it publishes: the first 20 frames' readings "
+                       "vote which depth layer they saw and the odometry so far is rescaled once by it (a "
+                       "jump), later readings correct the altitude; false: its first reading only"),
       numberParameter("time_jump_tolerance", p.time_jump_tolerance, "s", above(0.0),
                       "a stamp this far behind the last one restarts the odometry; less is a dropped "
                       "reordering"),

@@ -488,7 +488,8 @@ void OdometryRos::process(const InputFrame& frame) {
   if (parameters_.use_range && estimator_->config().initial_altitude > 0.0 && !scale_settled_) {
     // The initial altitude was the first reading, whichever surface it saw; the first frames'
     // readings and depth layers then vote which one it was (as oefmt_offline does ahead), and the
-    // altitude, so the scale from here on, is corrected once. Before that no reading is used.
+    // odometry is rescaled once (it jumps then, by the vote's factor). Before that no reading is
+    // used.
     constexpr int kScaleFrames = 20;
     const std::optional<double> vertical = verticalRangeAt(frame, body_tilt_);
     if (vertical && estimate->state == TrackingState::kTracking) {
@@ -497,9 +498,18 @@ void OdometryRos::process(const InputFrame& frame) {
     if (++scale_frames_ >= kScaleFrames) {
       scale_settled_ = true;
       if (const std::optional<double> factor = rangeScale(scale_votes_)) {
-        estimator_->observeAltitude(*factor * estimator_->altitude(), 1e-6);
+        // The first frames were integrated at the first reading's scale: all of it, and the last
+        // pose and the path published (so that the next twist is not a jump), at the voted one.
+        estimator_->rescale(*factor);
+        if (previous_pose_) previous_pose_ = rescaled(*previous_pose_, *factor);
+        for (geometry_msgs::PoseStamped& p : path_.poses) {
+          p.pose.position.x *= *factor;
+          p.pose.position.y *= *factor;
+          p.pose.position.z *= *factor;
+        }
         ROS_INFO_STREAM(name_ << ": scale from the rangefinder: the first readings fit a reference plane "
-                              << estimator_->altitude() << " m below");
+                              << estimator_->altitude() << " m below (the odometry so far times " << *factor
+                              << ")");
       }
       scale_votes_.clear();
     }

@@ -127,6 +127,41 @@ TEST(Estimator, ClimbShowsAsRisingZ) {
   EXPECT_NEAR(estimates.back().pms12.value, 0.0, 0.3);
 }
 
+TEST(Estimator, RescaleIsAsIfTheFlightHadStartedAtThatAltitude) {
+  // A climbing flight, twice: from the true altitude, and from 0.7 of it (a rangefinder's first
+  // reading of a roof) rescaled by 1/0.7 after 5 frames (its readings' vote). From then on the
+  // two are the same flight: the same poses, covariances and later steps.
+  const test::Flight flight =
+      test::renderFlight(test::flightTexture(), test::straightLine(10, 3.0, 2.0, 0.0, 1.02), kN);
+  EstimatorConfig low = flightConfig();
+  low.initial_altitude = 0.7 * kN;
+  Estimator truth(flightConfig()), rescaled(low);
+  for (std::size_t k = 0; k < flight.frames.size(); ++k) {
+    const std::optional<Estimate> a = truth.push(flight.frames[k], static_cast<double>(k));
+    std::optional<Estimate> b = rescaled.push(flight.frames[k], static_cast<double>(k));
+    ASSERT_TRUE(a && b);
+    if (k == 4) {
+      EXPECT_NEAR(b->pose.x, 0.7 * a->pose.x, 1e-6 * kN);  // before: at 0.7 of the scale
+      rescaled.rescale(1.0 / 0.7);
+      b->pose = rescaled.pose();
+    }
+    if (k < 4) continue;
+    const Pose4& p = a->pose;
+    const Pose4& q = b->pose;
+    EXPECT_NEAR(q.x, p.x, 1e-6 * kN) << k;
+    EXPECT_NEAR(q.y, p.y, 1e-6 * kN) << k;
+    EXPECT_NEAR(q.z, p.z, 1e-6 * kN) << k;
+    EXPECT_NEAR(q.yaw, p.yaw, 1e-9) << k;
+    EXPECT_NEAR(rescaled.altitude(), truth.altitude(), 1e-6 * kN) << k;
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) {
+        EXPECT_NEAR(q.covariance(r, c), p.covariance(r, c), 1e-6 * (std::fabs(p.covariance(r, c)) + 1e-6)) << k;
+      }
+    }
+  }
+  EXPECT_GT(truth.pose().z, 10.0);  // it climbed: z was rescaled too
+}
+
 TEST(Estimator, YawAndDirectionFollowTheRightHandRule) {
   // Turning counter-clockwise (seen from above) while flying east-north-east.
   const test::Flight flight = test::renderFlight(

@@ -140,6 +140,10 @@ class Estimator {
   /// measurement (a camera tilted by an unknown angle reads part of its horizontal motion as
   /// climb or descent).
   void observeAltitude(double altitude, double sigma, double drift_variance = 0.0);
+  /// Everything so far at another scale (PoseIntegrator::rescale): for a scale found after the
+  /// first frames (a rangefinder's vote), as if the flight had started at factor times the
+  /// initial altitude.
+  void rescale(double factor);
   /// The altitude above the reference plane now (output units).
   double altitude() const;
 

@@ -31,6 +31,10 @@ struct Pose4 {
   bool finite() const;
 };
 
+/// The pose with x, y, z times `factor` and their covariance times its square (a trajectory seen at
+/// another scale).
+Pose4 rescaled(const Pose4& pose, double factor);
+
 /// The covariance as a row-major 6x6 over (x, y, z, roll, pitch, yaw), as nav_msgs/Odometry
 /// wants it. Roll and pitch are not observed (the camera is assumed level): they get
 /// `unobserved_variance`. Every diagonal entry is at least `min_variance` (never publish zeros).
@@ -64,6 +68,10 @@ class PoseIntegrator {
   void correctAltitude(double altitude, double variance);
   /// Goes back to an earlier pose (e.g. undoing predictions once the real motion is known).
   void restore(const Pose4& pose) { pose_ = pose; }
+  /// Everything so far at another scale: the initial altitude and the position (x, y, z) times
+  /// `factor` (> 0), their covariance times its square, as if the flight had started at
+  /// factor times the initial altitude (every step's metres per pixel scale alike).
+  void rescale(double factor);
   /// The covariance the last integrate() or hold() added to the pose (x, y, z, yaw): the
   /// uncertainty of that one step alone, in the world frame and output units.
   const cv::Matx44d& lastStepCovariance() const { return last_step_covariance_; }

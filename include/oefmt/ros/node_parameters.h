@@ -30,7 +30,7 @@ struct RosParameters {
   double imu_timeout = 0.1;          ///< [s] an IMU orientation further than this from a frame is stale
   /// Keep the scale metric with every valid `altitude` range (off until the node's use of the
   /// readings matches oefmt_offline's accuracy).
-  bool use_range = false;
+  bool use_range = true;
   double time_jump_tolerance = 1.0;  ///< a stamp this far back [s] resets (bag loop)
   double diagnostics_period = 1.0;   ///< [s]
   double min_rate = 1.0;             ///< expected input/output rate window [Hz] for diagnostics
