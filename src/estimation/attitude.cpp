@@ -86,14 +86,16 @@ void AttitudeHistory::forgetBefore(double stamp) {
   while (samples_.size() > 1 && samples_[1].stamp <= stamp) samples_.pop_front();
 }
 
-TurnHistory::TurnHistory(double max_gap) : max_gap_(max_gap) {}
+TurnHistory::TurnHistory(double max_gap, const Eigen::Matrix3d& imu_from_body)
+    : max_gap_(max_gap), imu_from_body_(imu_from_body) {}
 
-bool TurnHistory::add(double stamp, const Eigen::Quaterniond& body_to_world, const Eigen::Vector3d& angular_velocity) {
+bool TurnHistory::add(double stamp, const Eigen::Quaterniond& imu_to_world, const Eigen::Vector3d& imu_rates) {
   if (!std::isfinite(stamp) || (!samples_.empty() && !(stamp > samples_.back().stamp))) return false;
+  const Eigen::Matrix3d r = imu_to_world.normalized().toRotationMatrix() * imu_from_body_;
+  const Eigen::Vector3d angular_velocity = imu_from_body_.transpose() * imu_rates;
   // The yaw's rate (yaw, pitch, roll about z, y', x''), the one angle the level view keeps: from
   // the body rates p, q, r, yaw' = (q sin roll + r cos roll) / cos pitch. (The world's vertical
   // rate is not it: a roll while pitched turns about it without changing the yaw.)
-  const Eigen::Matrix3d r = body_to_world.normalized().toRotationMatrix();
   const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
   const double roll = std::atan2(r(2, 1), r(2, 2));
   const double rate = (angular_velocity.y() * std::sin(roll) + angular_velocity.z() * std::cos(roll)) /

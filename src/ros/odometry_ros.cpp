@@ -226,13 +226,9 @@ std::optional<double> OdometryRos::gyroTurn(double from, double to) {
     }
   }
   if (samples.empty()) return std::nullopt;
-  // The camera body's yaw (the level view keeps it): the IMU's samples turned into it.
-  const Eigen::Matrix3d imu_from_camera = imuMount(imu_frame).transpose() * mount_ * downLookingMount().transpose();
-  const Eigen::Quaterniond camera(imu_from_camera);
-  TurnHistory turns(parameters_.imu_timeout);
-  for (const ImuSample& s : samples) {
-    turns.add(s.stamp, s.orientation * camera, imu_from_camera.transpose() * s.angular_velocity);
-  }
+  // The camera body's yaw (the level view keeps it), from the IMU's samples through the mounts.
+  TurnHistory turns(parameters_.imu_timeout, imuMount(imu_frame).transpose() * mount_ * downLookingMount().transpose());
+  for (const ImuSample& s : samples) turns.add(s.stamp, s.orientation, s.angular_velocity);
   return turns.turn(from, to);
 }
 

@@ -289,15 +289,12 @@ int main(int argc, char** argv) {
       } else {
         if (!options.bag.empty()) camera_in_imu = cameraMountInImu(options, imu_source);
         attitudes = std::make_shared<oefmt::AttitudeHistory>();
-        // The camera body's yaw (the level view keeps it): the IMU's orientation and rates turned
-        // into the camera body (the optical frame with y and z flipped).
-        turns.emplace();
-        const Eigen::Matrix3d imu_from_camera_body = camera_in_imu * oefmt::downLookingMount().transpose();
-        const Eigen::Quaterniond camera_body(imu_from_camera_body);
+        // The camera body's yaw (the level view keeps it): the camera body is the optical frame
+        // with y and z flipped.
+        turns.emplace(0.1, camera_in_imu * oefmt::downLookingMount().transpose());
         for (const oefmt::ImuSample& sample : imu_samples) {
           attitudes->add(sample.stamp, sample.orientation);
-          turns->add(sample.stamp, sample.orientation * camera_body,
-                     imu_from_camera_body.transpose() * sample.angular_velocity);
+          turns->add(sample.stamp, sample.orientation, sample.angular_velocity);
         }
         nadir = std::make_shared<const oefmt::NadirView>(undistorter->inputCamera(), image_size,
                                                           config.working_fx, config.registration.size);

@@ -152,6 +152,20 @@ TEST(Attitude, TurnHistoryIntegratesTheYawRateNotTheVerticalRate) {
     yawing.add(t, body, Eigen::Vector3d(0.0, 0.0, 0.3));
   }
   EXPECT_NEAR(*yawing.turn(0.205, 0.705), 0.15, 1e-9);  // ends between samples
+  // The same yaw through an IMU mounted upside down and turned a quarter: its own orientation and
+  // rates, and its mount, give the body's turn.
+  const Eigen::Matrix3d body_from_imu = (Eigen::AngleAxisd(M_PI / 2.0, Eigen::Vector3d::UnitZ()) *
+                                         Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))
+                                            .toRotationMatrix();
+  TurnHistory mounted(0.1, body_from_imu.transpose());
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.01 * k;
+    const Eigen::Quaterniond body(Eigen::AngleAxisd(0.3 * t, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()));
+    mounted.add(t, body * Eigen::Quaterniond(body_from_imu),
+                body_from_imu.transpose() * (body.conjugate() * Eigen::Vector3d(0.0, 0.0, 0.3)));
+  }
+  EXPECT_NEAR(*mounted.turn(0.205, 0.705), 0.15, 1e-9);
   EXPECT_FALSE(yawing.turn(0.5, 1.2).has_value());       // beyond the samples
   EXPECT_FALSE(yawing.turn(-0.1, 0.5).has_value());
   TurnHistory gap(0.1);

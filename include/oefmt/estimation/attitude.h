@@ -94,11 +94,13 @@ inline constexpr double kGyroRateError = 0.01;
 /// sudden yaw, a texture that matches itself turned).
 class TurnHistory {
  public:
-  /// max_gap: samples further apart than this [s] do not cover the time between them.
-  explicit TurnHistory(double max_gap = 0.1);
+  /// max_gap: samples further apart than this [s] do not cover the time between them;
+  /// imu_from_body: the body whose yaw is wanted (a camera body) in the frame of the samples.
+  explicit TurnHistory(double max_gap = 0.1, const Eigen::Matrix3d& imu_from_body = Eigen::Matrix3d::Identity());
 
-  /// Adds a sample; one not after the newest is ignored (returns false).
-  bool add(double stamp, const Eigen::Quaterniond& body_to_world, const Eigen::Vector3d& angular_velocity);
+  /// Adds a sample of the IMU (its orientation, to the world, and its angular velocity, in its
+  /// frame); one not after the newest is ignored (returns false).
+  bool add(double stamp, const Eigen::Quaterniond& imu_to_world, const Eigen::Vector3d& angular_velocity);
   /// The turn from `from` to `to` [rad, counter-clockwise seen from above]: the yaw rate
   /// integrated by trapezoids, linearly interpolated at both ends; nothing unless the samples
   /// cover [from, to] without a gap longer than max_gap.
@@ -114,6 +116,7 @@ class TurnHistory {
     double rate;  // of the yaw [rad/s]
   };
   double max_gap_;
+  Eigen::Matrix3d imu_from_body_;
   std::deque<Sample> samples_;
 };
 
