@@ -190,10 +190,12 @@ void OdometryRos::imuCallback(const sensor_msgs::ImuConstPtr& message) {
   const ImuSample sample = imuSample(*message);
   std::lock_guard<std::mutex> lock(vehicle_mutex_);
   imu_frame_ = message->header.frame_id;
+  // Frames older than kImuKept are long processed.
+  constexpr double kImuKept = 10.0;  // [s]
   if (recent_imu_.empty() || sample.stamp > recent_imu_.back().stamp) recent_imu_.push_back(sample);
-  while (!recent_imu_.empty() && recent_imu_.front().stamp < sample.stamp - 10.0) recent_imu_.pop_front();
+  while (!recent_imu_.empty() && recent_imu_.front().stamp < sample.stamp - kImuKept) recent_imu_.pop_front();
   attitudes_.add(sample.stamp, sample.orientation);
-  attitudes_.forgetBefore(sample.stamp - 10.0);  // frames older than that are long processed
+  attitudes_.forgetBefore(sample.stamp - kImuKept);
   const double roll = message->orientation_covariance[0], pitch = message->orientation_covariance[4];
   imu_orientation_variance_ = std::isfinite(roll) && std::isfinite(pitch) ? std::max({roll, pitch, 0.0}) : 0.0;
 }
@@ -486,12 +488,11 @@ void OdometryRos::process(const InputFrame& frame) {
     // readings and depth layers then vote which one it was (as oefmt_offline does ahead), and the
     // odometry is rescaled once (it jumps then, by the vote's factor). Before that no reading is
     // used.
-    constexpr int kScaleFrames = 20;
     const std::optional<double> vertical = verticalRangeAt(frame, body_tilt_);
     if (vertical && estimate->state == TrackingState::kTracking) {
       scale_votes_.push_back(rangeObservation(*estimator_, *estimate, *vertical));
     }
-    if (++scale_frames_ >= kScaleFrames) {
+    if (++scale_frames_ >= static_cast<int>(kRangeVoteFrames)) {
       scale_settled_ = true;
       if (const std::optional<double> factor = rangeScale(scale_votes_)) {
         // The first frames were integrated at the first reading's scale: all of it, and the last

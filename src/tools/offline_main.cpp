@@ -120,9 +120,6 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
   return oefmt::tools::parseCommandLine(app, argc, argv);
 }
 
-// Frames run ahead to find the rangefinder's scale.
-constexpr std::size_t kScaleFrames = 20;
-
 // A deep copy: the estimator warps a frame's grey image in place when it becomes the older one.
 oefmt::FrameSpectra cloneSpectra(const oefmt::FrameSpectra& s) {
   oefmt::FrameSpectra copy = s;
@@ -369,7 +366,7 @@ int main(int argc, char** argv) {
       oefmt::SourceFrame ahead;
       std::unique_ptr<oefmt::Estimator> provisional;
       std::vector<oefmt::RangeObservation> observations;
-      while (replay.size() < kScaleFrames && source.next(ahead)) {
+      while (replay.size() < oefmt::kRangeVoteFrames && source.next(ahead)) {
         const std::optional<double> vertical = verticalRange(ranges, ahead.stamp, ahead.tilt);
         if (!provisional) {
           if (!vertical) break;  // the first frame has no reading: the first reading decides

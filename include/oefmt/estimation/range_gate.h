@@ -12,6 +12,7 @@
 // them again, as readings of the reference plane.
 #pragma once
 
+#include <cstddef>
 #include <deque>
 #include <optional>
 #include <vector>
@@ -64,6 +65,10 @@ class RangeAltitude {
   double attitude_sigma_;
   double last_x_ = 0.0, last_y_ = 0.0;  // where the altitude was last measured
 };
+
+/// How many frames' readings vote which layer the rangefinder saw before the scale is taken from
+/// them (rangeScale): oefmt_offline runs them ahead, the node rescales after them.
+inline constexpr std::size_t kRangeVoteFrames = 20;
 
 /// One rangefinder reading beside the estimator's altitude and layers at its frame.
 struct RangeObservation {
