@@ -138,6 +138,12 @@ struct Estimator::State {
   std::optional<RegistrationPrior> predictedPair(int intervals, double seconds, const PairMotion* start) const;
   // A rotation measured otherwise (a gyro's) with its sigma in place of the prediction's.
   void takeTurn(RegistrationPrior& prior, double rotation, double sigma) const;
+  // The largest turn a pair spanning `seconds` can hold (the vehicle's yaw rate bound; none
+  // outside the oefmt mode, or without an interval).
+  double maxRotation(double seconds) const {
+    if (config.mode != EstimatorMode::kOefmt || !(seconds > 0.0)) return CV_PI;
+    return std::min(CV_PI, config.tracking.max_yaw_rate * seconds);
+  }
 
   const EstimatorConfig& config;
   Registrar registrar;
@@ -436,7 +442,8 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
                              ? pending02.get()
                              : registrar02.registerPair(f0->spectra, frame.spectra,
                                                         RegistrationMethod::kEnergyVectors, nullptr,
-                                                        prior02 ? &*prior02 : nullptr);
+                                                        prior02 ? &*prior02 : nullptr,
+                                                        maxRotation(frame.stamp - f0->stamp));
     est.has_registration02 = true;
   }
   est.registration_ms += msSince(t);
@@ -682,9 +689,10 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       // if pair 1-2 fails.
       const FrameSpectra& older = s.f0->spectra;
       const FrameSpectra& newer = frame.spectra;
-      s.pending02 = s.worker02.submit([&s, &older, &newer] {
+      const double max_rotation02 = s.maxRotation(frame.stamp - s.f0->stamp);
+      s.pending02 = s.worker02.submit([&s, &older, &newer, max_rotation02] {
         return s.registrar02.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr,
-                                          s.prior02 ? &*s.prior02 : nullptr);
+                                          s.prior02 ? &*s.prior02 : nullptr, max_rotation02);
       });
     }
     const PendingPairGuard pending_guard(s.pending02);
@@ -694,7 +702,8 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     if (turn && s.prior12) s.takeTurn(*s.prior12, -turn->first, turn->second);
     est.prediction12 = s.prior12;
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
-                                                  s.prior12 ? &*s.prior12 : nullptr);
+                                                  s.prior12 ? &*s.prior12 : nullptr,
+                                                  s.maxRotation(seconds12));
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {
       if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below

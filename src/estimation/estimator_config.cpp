@@ -171,6 +171,10 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
                       "largest acceleration of the vehicle: how far the next translation peak may lie "
                       "from the motion so far (fx a dt^2 / altitude px); a weaker peak inside that "
                       "window is accepted, an alias outside it is not taken at full confidence"),
+      numberParameter("tracking.max_yaw_rate", t.max_yaw_rate, "rad/s", closedRange(0.01, 1000.0),
+                      "largest yaw rate of the vehicle: a pair's rotation beyond it over the frames' "
+                      "interval is not taken, and below a quarter turn it decides the half-turn "
+                      "ambiguity of the rotation (a texture alike when turned cannot flip the heading)"),
       numberParameter("tracking.assumed_altitude", t.assumed_altitude, "m", closedRange(0.01, 1e5),
                       "distance to the scene the acceleration window assumes when the altitude is "
                       "unknown: low on purpose, which makes the window wide rather than wrong"),

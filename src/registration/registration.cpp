@@ -108,9 +108,10 @@ double Registrar::logZoomPerBin() const { return std::log(context_->logPolarBase
 PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameSpectra& newer,
                                          RegistrationMethod method,
                                          RegistrationSurfaces* surfaces,
-                                         const RegistrationPrior* prior) {
+                                         const RegistrationPrior* prior, double max_rotation) {
   const int n = context_->size();
   if (older.empty() || newer.empty()) throw InputError("registerPair: a frame is empty");
+  max_rotation_ = max_rotation > 0.0 ? max_rotation : CV_PI;  // NaN: unbounded
   if (older.grey.rows != n || newer.grey.rows != n || older.spectrum.size() != newer.spectrum.size()) {
     throw InputError("registerPair: frames were analysed at a different size than " +
                      std::to_string(n));
@@ -244,12 +245,14 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   result.confidence =
       std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
                translation_confidence);
-  // A rotation or zoom the motion so far rules out (another peak of the whole surface, a half
-  // turn the low-resolution test chose) is not taken, however well its translation matched: a
-  // repetitive pattern matches itself turned by a quarter, or scaled by its period.
-  if (prior != nullptr &&
-      (std::fabs(wrapAngle(result.rotation - prior->rotation)) > prior->rotation_window ||
-       std::fabs(std::log(result.zoom) - prior->log_zoom) > prior->log_zoom_window)) {
+  // A rotation beyond the vehicle's reach, or a rotation or zoom the motion so far rules out
+  // (another peak of the whole surface, a half turn the low-resolution test chose), is not
+  // taken, however well its translation matched: a repetitive pattern matches itself turned by
+  // a quarter, or scaled by its period.
+  if (std::fabs(result.rotation) > max_rotation_ ||
+      (prior != nullptr &&
+       (std::fabs(wrapAngle(result.rotation - prior->rotation)) > prior->rotation_window ||
+        std::fabs(std::log(result.zoom) - prior->log_zoom) > prior->log_zoom_window))) {
     result.rotation_zoom_implausible = true;
     result.confidence = 0.0;
   }
@@ -360,6 +363,10 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
+  } else if (test_half_turn && context_->config().resolve_half_turn && max_rotation_ < CV_PI / 2.0) {
+    // The vehicle cannot have turned by a quarter turn: the smaller of the two rotations. (The
+    // surface's rotation lies within a quarter turn of zero.)
+    result.half_turn = false;
   } else if (test_half_turn && context_->config().resolve_half_turn) {
     // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
     // hypothesis needs no second warp; a low-resolution correlation decides between the two

@@ -73,6 +73,12 @@ struct TrackingConfig {
   /// outside the window and off the direction of motion (a repetitive texture's alias) is not
   /// taken at full confidence.
   double max_acceleration = 10.0;
+  /// Largest yaw rate of the vehicle [rad/s] (a multirotor's fastest commanded yaw, about
+  /// 200 deg/s). A pair's rotation beyond it over the frames' interval is not taken, and where it
+  /// allows less than a quarter turn the rotation surface's half-turn ambiguity is decided for
+  /// the smaller turn: a texture that looks the same turned by half a turn (bricks, tiles, a
+  /// lattice) cannot flip the heading.
+  double max_yaw_rate = 3.5;
   /// Distance to the scene [m] the acceleration window assumes when the altitude is unknown:
   /// low on purpose, which makes the window wide rather than wrong.
   double assumed_altitude = 5.0;

@@ -130,10 +130,14 @@ class Registrar {
   FrameSpectra analyse(const PreparedImage& image);
 
   /// Registers older -> newer. Throws InputError if a frame is empty or the sizes differ.
+  /// max_rotation [rad]: the largest turn the pair can hold (the vehicle's largest yaw rate over
+  /// the frames' interval). Below a quarter turn it decides the half-turn ambiguity of the
+  /// rotation surface (the smaller turn), and a rotation beyond it is never confident: a
+  /// periodic texture matches itself turned by a half or a quarter turn as well as unturned.
   PairRegistration registerPair(const FrameSpectra& older, const FrameSpectra& newer,
                                 RegistrationMethod method = RegistrationMethod::kEnergyVectors,
                                 RegistrationSurfaces* surfaces = nullptr,
-                                const RegistrationPrior* prior = nullptr);
+                                const RegistrationPrior* prior = nullptr, double max_rotation = CV_PI);
 
   const SpectralContext& context() const { return *context_; }
   std::shared_ptr<const SpectralContext> sharedContext() const { return context_; }
@@ -192,6 +196,7 @@ class Registrar {
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;
   int rotation_zoom_candidates_;
+  double max_rotation_ = CV_PI;  // of the pair being registered (see registerPair)
 };
 
 }  // namespace oefmt
