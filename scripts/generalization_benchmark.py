@@ -123,7 +123,7 @@ CORPUS = [
 ]
 
 # A few minutes: what the test command runs and asserts on.
-CI_SUBSET = ["circle-parallax", "line-hill", "spin", "eight-natural-yaw", "circle-natural"]
+CI_SUBSET = ["circle-parallax", "line-hill", "spin", "eight-natural-yaw", "circle-natural", "line-brick-flat"]
 
 
 def run(command, **kwargs):
