@@ -138,6 +138,20 @@ struct Estimator::State {
   std::optional<RegistrationPrior> predictedPair(int intervals, double seconds, const PairMotion* start) const;
   // A rotation measured otherwise (a gyro's) with its sigma in place of the prediction's.
   void takeTurn(RegistrationPrior& prior, double rotation, double sigma) const;
+  // The prediction of a pair that no motion so far predicts (the first pair, or the first after a
+  // restart): the vehicle held its heading and altitude. Its window is the turn the vehicle can
+  // make and every zoom; where no peak of it registers the translation is tried with no turn and
+  // no zoom, whose sigmas are how far they could be off and still leave a translation peak
+  // standing out: about a pixel at the image's edge.
+  RegistrationPrior stillPrior(double seconds) const {
+    const int n = config.registration.size;
+    RegistrationPrior still;
+    still.rotation_window = std::min(maxRotation(seconds), CV_PI / 2.0);
+    still.log_zoom_window = (n / 2 - 1) * registrar.logZoomPerBin();
+    still.rotation_sigma = 2.0 / n;
+    still.log_zoom_sigma = 2.0 / n;
+    return still;
+  }
   // The largest turn a pair spanning `seconds` can hold (the vehicle's yaw rate bound; none
   // outside the oefmt mode, or without an interval).
   double maxRotation(double seconds) const {
@@ -704,6 +718,20 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
                                                   s.prior12 ? &*s.prior12 : nullptr,
                                                   s.maxRotation(seconds12));
+    if (!est.registration12.usable() && !s.prior12 && config_.mode == EstimatorMode::kOefmt) {
+      // Nothing predicted this pair and the rotation/zoom surface's highest peaks did not
+      // register (at low overlap the shared part of two frames is small, and a wrong peak can be
+      // the highest): the vehicle may simply have held its heading and altitude.
+      const RegistrationPrior still = s.stillPrior(seconds12);
+      RegistrationSurfaces still_surfaces;
+      PairRegistration retry = s.registrar.registerPair(s.f1->spectra, frame.spectra, method,
+                                                        surfaces ? &still_surfaces : nullptr, &still,
+                                                        s.maxRotation(seconds12));
+      if (retry.confidence > est.registration12.confidence) {
+        est.registration12 = std::move(retry);
+        if (surfaces) *surfaces = std::move(still_surfaces);
+      }
+    }
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {
       if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below
