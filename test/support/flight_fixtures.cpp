@@ -2,8 +2,11 @@
 #include "support/flight_fixtures.h"
 
 #include <cmath>
+#include <memory>
 #include <mutex>
 
+#include "oefmt/sim/renderer.h"
+#include "oefmt/sim/scene.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
 
@@ -77,6 +80,16 @@ const cv::Mat1f& flightTexture() {
     texture = sim::proceduralTexture(cv::Size(2048, 2048), 31, sim::TextureStyle::kCells, 40.0);
   });
   return texture;
+}
+
+std::vector<cv::Mat1b> renderPlan(const sim::FlightPlan& plan) {
+  const sim::Renderer renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, plan.supersample);
+  std::vector<cv::Mat1b> frames;
+  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
+    frames.push_back(sim::sensorImage(renderer.render(plan.poses[k]).image, plan.sensor, plan.scene.seed,
+                                      static_cast<int>(k)));
+  }
+  return frames;
 }
 
 void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,

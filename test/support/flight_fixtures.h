@@ -10,6 +10,7 @@
 
 #include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/camera_model.h"
+#include "oefmt/sim/flight.h"
 #include "oefmt/estimation/pose.h"
 
 namespace oefmt {
@@ -51,6 +52,10 @@ Flight renderTwoLayerFlight(const cv::Mat1f& ground, const cv::Mat1f& roofs, con
 
 /// The scene texture of the flight tests (2048 x 2048, cells, seeded).
 const cv::Mat1f& flightTexture();
+
+/// Every frame of a simulator flight plan as its camera gives it (rendered, then the sensor's
+/// noise and brightness).
+std::vector<cv::Mat1b> renderPlan(const sim::FlightPlan& plan);
 
 /// Appends frame `index`'s estimated position and the simulated flight's true one, both stamped
 /// with the index (for an evaluation that associates by index).

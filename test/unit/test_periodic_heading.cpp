@@ -9,15 +9,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <memory>
 #include <vector>
 
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/evaluation/evaluation.h"
 #include "oefmt/registration/registration.h"
 #include "oefmt/sim/flight.h"
-#include "oefmt/sim/renderer.h"
-#include "oefmt/sim/scene.h"
 #include "oefmt/sim/texture.h"
 #include "support/flight_fixtures.h"
 
@@ -35,16 +32,6 @@ sim::FlightPlan brickLine(int frames) {
   plan.poses.resize(frames);
   plan.stamps.resize(frames);
   return plan;
-}
-
-std::vector<cv::Mat1b> render(const sim::FlightPlan& plan) {
-  const sim::Renderer renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, plan.supersample);
-  std::vector<cv::Mat1b> frames;
-  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
-    frames.push_back(sim::sensorImage(renderer.render(plan.poses[k]).image, plan.sensor, plan.scene.seed,
-                                      static_cast<int>(k)));
-  }
-  return frames;
 }
 
 struct FlightRun {
@@ -85,7 +72,7 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
 TEST(PeriodicHeading, BrickTextureReadsTheSameTurnedByHalfATurn) {
   // The premise: the two readings of the rotation are equally good matches on this texture.
   const sim::FlightPlan plan = brickLine(2);
-  const std::vector<cv::Mat1b> frames = render(plan);
+  const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
   RegistrationConfig config;
   config.fft_planning = FftPlanning::kEstimate;
   Registrar registrar(config);
@@ -103,7 +90,7 @@ TEST(PeriodicHeading, BrickTextureReadsTheSameTurnedByHalfATurn) {
 TEST(PeriodicHeading, TheYawRateBoundKeepsTheHeadingOnABrickLine) {
   const sim::FlightPlan plan = brickLine(30);
   ASSERT_LT(plan.stamps[1] - plan.stamps[0], 0.5) << "frames close enough in time that a turn is bounded";
-  const std::vector<cv::Mat1b> frames = render(plan);
+  const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
   const FlightRun bounded = fly(plan, frames, EstimatorConfig{}.tracking.max_yaw_rate);
   const FlightRun unbounded = fly(plan, frames, 1000.0);  // any turn is possible between frames
   std::printf("[ periodic heading ] worst heading step %.2f deg, drift %.2f %% (unbounded yaw rate: %.2f deg, %.2f %%)\n",

@@ -8,14 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <memory>
 #include <vector>
 
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/registration/registration.h"
 #include "oefmt/sim/flight.h"
-#include "oefmt/sim/renderer.h"
-#include "oefmt/sim/scene.h"
+#include "support/flight_fixtures.h"
 
 namespace oefmt {
 namespace {
@@ -31,19 +29,9 @@ sim::FlightPlan lowOverlapEight(int frames) {
   return plan;
 }
 
-std::vector<cv::Mat1b> render(const sim::FlightPlan& plan) {
-  const sim::Renderer renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, plan.supersample);
-  std::vector<cv::Mat1b> frames;
-  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
-    frames.push_back(sim::sensorImage(renderer.render(plan.poses[k]).image, plan.sensor, plan.scene.seed,
-                                      static_cast<int>(k)));
-  }
-  return frames;
-}
-
 TEST(UnpredictedPair, ALowOverlapFirstPairRegistersAsTheVehicleHoldingHeadingAndAltitude) {
   const sim::FlightPlan plan = lowOverlapEight(6);
-  const std::vector<cv::Mat1b> frames = render(plan);
+  const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
 
   // The premise: the surface's peaks alone do not register the first pair.
   RegistrationConfig registration;
