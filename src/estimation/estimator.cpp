@@ -346,7 +346,9 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   ++failed;
   est.degraded = true;
   if (!anchor) anchor = integrator.pose();
-  if (config.tracking.predict_failed_frames && last_step && failed <= config.tracking.max_failed_frames) {
+  // The frame that restarts the window is predicted too: the vehicle kept moving while frames
+  // failed, and a held pose would drop one step from the trajectory.
+  if (config.tracking.predict_failed_frames && last_step && failed <= config.tracking.max_failed_frames + 1) {
     PairMotion predicted = *last_step;
     const double spread = config.tracking.prediction_sigma * predicted.shift();
     predicted.translation_covariance += cv::Matx22d::eye() * (spread * spread + 1.0);
@@ -356,7 +358,7 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
     est.state = TrackingState::kPredicted;
     // The next frame would be registered against frame 1 over one more interval: at low overlap
     // that pair is out of reach, and every later frame would fail too.
-    if (textured && f1 &&
+    if (failed <= config.tracking.max_failed_frames && textured && f1 &&
         !shiftInReach(last_step->translation * (static_cast<double>(frame.index - f1->index) + 1.0))) {
       slideTo(std::move(frame), predicted);
       return;

@@ -7,6 +7,8 @@
 #include <limits>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/sim/similarity_views.h"
@@ -259,16 +261,52 @@ TEST(Estimator, LongFailuresRestartTheWindow) {
   const cv::Mat1f grey(kN, kN, 0.5f);
   std::vector<TrackingState> states;
   for (int k = 0; k < 3; ++k) states.push_back(estimator.push(flight.frames[k], k)->state);
-  for (int k = 3; k < 6; ++k) states.push_back(estimator.push(grey, k)->state);
-  // A textureless frame cannot anchor a restart: the pose is held until a textured one comes.
+  std::vector<double> xs;
+  for (int k = 3; k < 6; ++k) {
+    const std::optional<Estimate> e = estimator.push(grey, k);
+    states.push_back(e->state);
+    xs.push_back(e->pose.x);
+  }
+  // Failed frames are predicted, the one that restarts the window too (the vehicle kept
+  // moving); a textureless frame cannot anchor the restart: the pose is held from then until a
+  // textured one comes.
   EXPECT_EQ(states[3], TrackingState::kPredicted);
   EXPECT_EQ(states[4], TrackingState::kPredicted);
-  EXPECT_EQ(states[5], TrackingState::kHeld);
+  EXPECT_EQ(states[5], TrackingState::kPredicted);
+  EXPECT_GT(std::fabs(xs[2] - xs[1]), 0.5 * std::fabs(xs[1] - xs[0])) << "the restarting frame moved on";
   const std::optional<Estimate> anchor = estimator.push(flight.frames[3], 6.0);
   EXPECT_EQ(anchor->state, TrackingState::kHeld);  // becomes the new anchor
   const std::optional<Estimate> resumed = estimator.push(flight.frames[4], 7.0);
   EXPECT_EQ(resumed->state, TrackingState::kTracking);
   EXPECT_TRUE(resumed->pose.finite());
+}
+
+TEST(Estimator, TheFrameThatRestartsTheWindowIsPredicted) {
+  const test::Flight flight =
+      test::renderFlight(test::flightTexture(), test::straightLine(3, 4.0, 0.0), kN);
+  EstimatorConfig config = flightConfig();
+  config.tracking.max_failed_frames = 2;
+  Estimator estimator(config);
+  double x = 0.0, previous_x = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    previous_x = x;
+    x = estimator.push(flight.frames[k], k)->pose.x;
+  }
+  const double step = x - previous_x;
+  ASSERT_GT(std::fabs(step), 1.0);
+  // Textured frames that match nothing before them (a camera swung away): two predicted, then
+  // the restart, whose pose is predicted too.
+  cv::RNG rng(7);
+  for (int k = 3; k < 6; ++k) {
+    cv::Mat1f unrelated(kN, kN);
+    rng.fill(unrelated, cv::RNG::UNIFORM, 0.0f, 1.0f);
+    cv::GaussianBlur(unrelated, unrelated, cv::Size(0, 0), 3.0);
+    const std::optional<Estimate> e = estimator.push(unrelated, k);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_EQ(e->state, k < 5 ? TrackingState::kPredicted : TrackingState::kRestarted) << "frame " << k;
+    EXPECT_NEAR(e->pose.x - x, step, 0.05 * std::fabs(step)) << "frame " << k;
+    x = e->pose.x;
+  }
 }
 
 TEST(Estimator, ResetStampsAndBadInput) {

@@ -29,7 +29,7 @@ enum class TrackingState {
   kTracking,   ///< registered against the previous accepted frame: the pose moved by the estimate
   kPredicted,  ///< the frame could not be registered: pose extrapolated with the last motion
   kHeld,       ///< the frame could not be registered and there was no motion to extrapolate
-  kRestarted,  ///< too many frames failed: the window restarts from this frame, pose continues
+  kRestarted,  ///< too many frames failed: the window restarts from this frame (pose predicted, or held)
 };
 inline constexpr EnumName<TrackingState> kTrackingStateNames[] = {
     {TrackingState::kStarted, "started"}, {TrackingState::kTracking, "tracking"},
