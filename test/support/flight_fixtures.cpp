@@ -2,11 +2,8 @@
 #include "support/flight_fixtures.h"
 
 #include <cmath>
-#include <memory>
 #include <mutex>
 
-#include "oefmt/sim/renderer.h"
-#include "oefmt/sim/scene.h"
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
 
@@ -82,14 +79,25 @@ const cv::Mat1f& flightTexture() {
   return texture;
 }
 
+sim::FlightPlan plannedFlight(const sim::FlightOptions& options, int frames) {
+  sim::FlightPlan plan = sim::planFlight(options);
+  plan.poses.resize(frames);
+  plan.stamps.resize(frames);
+  return plan;
+}
+
 std::vector<cv::Mat1b> renderPlan(const sim::FlightPlan& plan) {
-  const sim::Renderer renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, plan.supersample);
   std::vector<cv::Mat1b> frames;
-  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
-    frames.push_back(sim::sensorImage(renderer.render(plan.poses[k]).image, plan.sensor, plan.scene.seed,
-                                      static_cast<int>(k)));
-  }
+  sim::renderFlight(plan, [&frames](int, const cv::Mat1b& image, const cv::Mat1b&) { frames.push_back(image); });
   return frames;
+}
+
+EstimatorConfig simulatedFlightConfig(const sim::FlightPlan& plan) {
+  EstimatorConfig config;
+  config.registration.fft_planning = FftPlanning::kEstimate;
+  config.initial_altitude = plan.track.altitude;
+  config.working_fx = plan.camera.intrinsics.fx;
+  return config;
 }
 
 void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,

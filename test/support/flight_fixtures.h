@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/estimation/estimator_config.h"
 #include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/camera_model.h"
 #include "oefmt/sim/flight.h"
@@ -53,9 +54,15 @@ Flight renderTwoLayerFlight(const cv::Mat1f& ground, const cv::Mat1f& roofs, con
 /// The scene texture of the flight tests (2048 x 2048, cells, seeded).
 const cv::Mat1f& flightTexture();
 
-/// Every frame of a simulator flight plan as its camera gives it (rendered, then the sensor's
-/// noise and brightness).
+/// The simulator's plan for `options`, cut to its first `frames` frames.
+sim::FlightPlan plannedFlight(const sim::FlightOptions& options, int frames);
+
+/// Every frame of a simulator flight plan as its camera gives it (sim::renderFlight).
 std::vector<cv::Mat1b> renderPlan(const sim::FlightPlan& plan);
+
+/// The estimator's configuration for a simulated flight: its true initial altitude (metric
+/// output), its camera's focal length, FFT plans estimated (fast to make).
+EstimatorConfig simulatedFlightConfig(const sim::FlightPlan& plan);
 
 /// Appends frame `index`'s estimated position and the simulated flight's true one, both stamped
 /// with the index (for an evaluation that associates by index).

@@ -34,10 +34,7 @@ sim::FlightPlan circlePiece() {
   sim::FlightOptions options;
   options.track.heading = sim::HeadingMode::kTrack;
   options.seed = 5;
-  sim::FlightPlan plan = sim::planFlight(options);
-  plan.poses.resize(40);
-  plan.stamps.resize(40);
-  return plan;
+  return test::plannedFlight(options, 40);
 }
 
 std::vector<cv::Mat1b> render(const sim::FlightPlan& plan, const std::shared_ptr<const sim::Scene>& scene,

@@ -28,10 +28,7 @@ sim::FlightPlan brickLine(int frames) {
   options.flat = true;
   options.texture_styles = {sim::TextureStyle::kBrick};
   options.seed = 41;
-  sim::FlightPlan plan = sim::planFlight(options);
-  plan.poses.resize(frames);
-  plan.stamps.resize(frames);
-  return plan;
+  return test::plannedFlight(options, frames);
 }
 
 struct FlightRun {
@@ -40,10 +37,7 @@ struct FlightRun {
 };
 
 FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames, double max_yaw_rate) {
-  EstimatorConfig config;
-  config.registration.fft_planning = FftPlanning::kEstimate;
-  config.initial_altitude = plan.track.altitude;
-  config.working_fx = plan.camera.intrinsics.fx;
+  EstimatorConfig config = test::simulatedFlightConfig(plan);
   config.tracking.max_yaw_rate = max_yaw_rate;
   Estimator estimator(config);
   StampedTrajectory estimate, truth;

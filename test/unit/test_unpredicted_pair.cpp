@@ -23,10 +23,7 @@ sim::FlightPlan lowOverlapEight(int frames) {
   options.track.shape = sim::TrackShape::kEight;
   options.overlap = 0.65;
   options.seed = 4;
-  sim::FlightPlan plan = sim::planFlight(options);
-  plan.poses.resize(frames);
-  plan.stamps.resize(frames);
-  return plan;
+  return test::plannedFlight(options, frames);
 }
 
 TEST(UnpredictedPair, ALowOverlapFirstPairRegistersAsTheVehicleHoldingHeadingAndAltitude) {
@@ -40,10 +37,7 @@ TEST(UnpredictedPair, ALowOverlapFirstPairRegistersAsTheVehicleHoldingHeadingAnd
   const PairRegistration alone = registrar.registerPair(registrar.analyse(frames[0]), registrar.analyse(frames[1]));
   EXPECT_FALSE(alone.usable()) << "the first pair registered without help (rotation " << alone.rotation << ")";
 
-  EstimatorConfig config;
-  config.registration.fft_planning = FftPlanning::kEstimate;
-  config.initial_altitude = plan.track.altitude;
-  config.working_fx = plan.camera.intrinsics.fx;
+  const EstimatorConfig config = test::simulatedFlightConfig(plan);
   Estimator estimator(config);
   for (std::size_t k = 0; k < frames.size(); ++k) {
     const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
