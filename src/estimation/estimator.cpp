@@ -586,13 +586,13 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
 
 Estimator::Estimator(const EstimatorConfig& config) : config_(config) {
   config_.validate();
-  state_ = std::make_unique<State>(config_, std::make_shared<const SpectralContext>(config_.registration));
+  state_ = std::make_unique<State>(config_, std::make_shared<const SpectralContext>(config_.modeRegistration()));
 }
 
 Estimator::Estimator(const EstimatorConfig& config, std::shared_ptr<const SpectralContext> context)
     : config_(config) {
   config_.validate();
-  if (!context || context->config() != config_.registration) {
+  if (!context || context->config() != config_.modeRegistration()) {
     throw InputError("Estimator: the spectral context was made for other registration parameters");
   }
   state_ = std::make_unique<State>(config_, std::move(context));

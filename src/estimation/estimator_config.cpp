@@ -88,6 +88,10 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
       booleanParameter("registration.noise_weighting", r.noise_weighting,
                        "weight each frequency of the translation correlation by its share of signal "
                        "(sensor noise estimated from the spectrum's outer ring)"),
+      booleanParameter("registration.refine_zoom", r.refine_zoom,
+                       "oefmt mode: refine each registered zoom by Gauss-Newton on the smoothed "
+                       "intensities of both frames (the log-polar correlation reads a sub-bin zoom "
+                       "towards the nearest bin)"),
       wordParameter("registration.fft_planning", r.fft_planning, kFftPlanningNames,
                     "FFTW planning effort, paid once per size and machine (plans are kept as FFTW "
                     "wisdom); patient plans the fastest FFTs"),
@@ -238,6 +242,12 @@ void EfmtConfig::validate() const {
   EstimatorConfig c;
   c.efmt = *this;
   checkSection(c, "efmt");
+}
+
+RegistrationConfig EstimatorConfig::modeRegistration() const {
+  RegistrationConfig r = registration;
+  r.refine_zoom = r.refine_zoom && mode == EstimatorMode::kOefmt;
+  return r;
 }
 
 void EstimatorConfig::validate() const {

@@ -11,6 +11,7 @@
 #include "oefmt/registration/energy_vector.h"
 #include "oefmt/error.h"
 #include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/similarity_refinement.h"
 #include "oefmt/registration/warp.h"
 
 namespace oefmt {
@@ -81,6 +82,44 @@ EnergyVectorOptions energyVectorOptions(const RegistrationConfig& config) {
   options.block_radius = config.block_radius;
   options.smoothing_sigma = config.energy_smoothing_sigma;
   return options;
+}
+
+// Gauss-Newton steps of the zoom refinement (it starts within a bin: the first step lands close,
+// the second reweighs the pixels), and the pixels that take part: about 3 000 on a regular grid
+// pin four parameters and a photometric gain and bias far below a bin at any size.
+constexpr int kRefinementIterations = 2;
+constexpr double kRefinementPixels = 3000.0;
+// A refinement that moves the rotation or the zoom by more than this many bins of the log-polar
+// surface did not start within its reach (another layer, a repetitive pattern): not taken.
+constexpr double kRefinementMaxBins = 2.0;
+
+// The log-polar surface reads a sub-bin zoom (and rotation) towards the nearest bin: at most
+// radii its samples are as coarse as the grain of the magnitude spectrum, so a fraction of a bin
+// does not move them as a whole. The intensities of both frames tell the rest (doc/method.md).
+// The rotation is refined along with the zoom, which it would otherwise bias, but not taken:
+// where the scene holds several depths or inclined planes, the rotation that fits the most pixels
+// differs from the followed layer's by a fraction of a bin, and the heading carries every such
+// error into the direction of all later steps.
+void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const SpectralContext& context,
+                double log_zoom_per_bin, PairRegistration& result) {
+  if (older.refinement.empty() || newer.refinement.empty()) return;
+  const int n = context.size();
+  ImageSimilarity start;
+  start.rotation = result.rotation;
+  start.log_zoom = std::log(result.zoom);
+  start.translation = result.translation;
+  const int stride = std::max(1, static_cast<int>(std::lround(n / std::sqrt(kRefinementPixels))));
+  const SimilarityRefinement refined = refineSimilarity(older.refinement, newer.refinement, start,
+                                                        context.window().taper(), kRefinementIterations, stride);
+  const double rotation_bins = std::fabs(refined.similarity.rotation - start.rotation) * n / CV_PI;
+  const double zoom_bins = std::fabs(refined.similarity.log_zoom - start.log_zoom) / log_zoom_per_bin;
+  if (!(refined.residual_end >= 0.0 && refined.residual_end <= refined.residual_start) ||
+      !(rotation_bins <= kRefinementMaxBins) ||
+      !(zoom_bins <= kRefinementMaxBins)) {
+    return;
+  }
+  result.zoom = std::exp(refined.similarity.log_zoom);
+  result.zoom_refined = true;
 }
 
 double confidenceFrom(double psr, double floor, double good) {
@@ -259,6 +298,9 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   result.status = result.confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
+  if (result.status == RegistrationStatus::kOk && context_->config().refine_zoom) {
+    refineZoom(older, newer, *context_, logZoomPerBin(), result);
+  }
 }
 
 void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer,

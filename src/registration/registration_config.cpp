@@ -36,7 +36,8 @@ bool operator==(const RegistrationConfig& a, const RegistrationConfig& b) {
          a.min_confidence == b.min_confidence &&
          a.rotation_zoom_candidates == b.rotation_zoom_candidates &&
          a.identity_warp_px == b.identity_warp_px &&
-         a.fft_planning == b.fft_planning && a.noise_weighting == b.noise_weighting;
+         a.fft_planning == b.fft_planning && a.noise_weighting == b.noise_weighting &&
+         a.refine_zoom == b.refine_zoom;
 }
 
 }  // namespace oefmt

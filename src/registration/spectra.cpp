@@ -212,6 +212,7 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   context_->window().apply(frame.grey, windowed, frame.mean);
   fft.forwardInPlace(frame.spectrum);
   if (context_->config().noise_weighting) frame.noise_power = noisePower(frame.spectrum);
+  if (context_->config().refine_zoom) frame.refinement = makeRefinementImage(frame.grey);
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   cv::Mat1f log_polar = fft.inPlaceInput(frame.log_polar_spectrum);
   context_->logPolar(magnitude_, log_polar);

@@ -320,7 +320,7 @@ int main(int argc, char** argv) {
       const std::string notice = oefmt::fftPlanningNotice(config.registration);
       if (!notice.empty()) std::fprintf(stderr, "oefmt_offline: %s\n", notice.c_str());
     }
-    const auto context = std::make_shared<const oefmt::SpectralContext>(config.registration);
+    const auto context = std::make_shared<const oefmt::SpectralContext>(config.modeRegistration());
     oefmt::PrefetchingSource source(
         std::move(opened), 2,
         [builder = oefmt::SpectraBuilder(context), undistorter, attitudes, nadir, camera_in_imu,

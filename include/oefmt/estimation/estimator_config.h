@@ -135,6 +135,9 @@ struct EstimatorConfig {
   double effectiveFx() const { return working_fx > 0.0 ? working_fx : registration.size; }
   /// Z_0 in output units: initial_altitude, or 1 when unknown.
   double initialAltitudeOrOne() const { return initial_altitude > 0.0 ? initial_altitude : 1.0; }
+  /// The registration parameters the mode runs with: the comparison modes (efmt, fmt) are the
+  /// published methods, without the rotation/zoom refinement.
+  RegistrationConfig modeRegistration() const;
   /// Throws InputError naming the first invalid field.
   void validate() const;
 };

@@ -67,6 +67,8 @@ struct PairRegistration {
   double followed_confidence = 0.0;
   /// The rotation or zoom lay outside the prior's window: not confident, whatever the peaks.
   bool rotation_zoom_implausible = false;
+  /// The zoom was refined on the intensities (registration.refine_zoom).
+  bool zoom_refined = false;
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
   bool warped = true;

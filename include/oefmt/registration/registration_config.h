@@ -29,6 +29,9 @@ struct RegistrationConfig {
   /// Weight each frequency of the translation correlation by its share of signal (sensor noise
   /// estimated from the spectrum's outer ring, see noisePower).
   bool noise_weighting = true;
+  /// Refine each registered zoom on the images themselves (Gauss-Newton on the intensities): the
+  /// log-polar correlation reads sub-bin zooms towards the nearest bin.
+  bool refine_zoom = true;
 
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -11,6 +11,7 @@
 
 #include "oefmt/registration/registration_config.h"
 #include "oefmt/registration/fft.h"
+#include "oefmt/registration/similarity_refinement.h"
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/registration/simd_kernel_choice.h"
 #include "oefmt/registration/window.h"
@@ -71,6 +72,7 @@ struct FrameSpectra {
   float mean = 0.0f;            ///< grey mean, subtracted before apodization
   int invalid_pixels = 0;       ///< non-finite input pixels that were replaced
   float noise_power = 0.0f;     ///< noisePower(spectrum) (0 without noise weighting)
+  RefinementImage refinement;   ///< smoothed grey and gradients (empty without the refinement)
 
   bool empty() const { return grey.empty(); }
 };

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Refines a pair's rotation, zoom and shift on the images themselves (Gauss-Newton on the
+// intensities), after the spectral registration has found them to within a bin.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace oefmt {
+
+/// A frame's image as the refinement reads it.
+struct RefinementImage {
+  cv::Mat1f smooth;  ///< the grey image, Gaussian-smoothed
+
+  bool empty() const { return smooth.empty(); }
+};
+
+/// Smooths `grey`.
+RefinementImage makeRefinementImage(const cv::Mat1f& grey);
+
+/// A similarity in the registration's convention (PairRegistration): the newer frame B shows the
+/// older A turned by `rotation` (counter-clockwise on screen) and scaled by exp(log_zoom) about
+/// the image centre, then shifted by `translation` [px].
+struct ImageSimilarity {
+  double rotation = 0.0;
+  double log_zoom = 0.0;
+  cv::Point2d translation;
+};
+
+struct SimilarityRefinement {
+  bool converged = false;   ///< the steps shrank below the tolerance within the iterations
+  ImageSimilarity similarity;    ///< the refined motion (the start when nothing was refined)
+  double residual_start = 0.0;  ///< robust sigma of the intensity residuals at the start
+  double residual_end = 0.0;    ///< ... at the refined motion (negative: too few pixels)
+  int pixels = 0;               ///< pixels of the sparse grid inside both frames at the end
+};
+
+/// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see, weighted by
+/// `taper` (the apodization, on both axes) and by Tukey's biweight at the residuals' robust sigma
+/// (measured before each step), so that a layer moving otherwise (parallax) or new content counts
+/// for little. Every `stride`-th pixel of every `stride`-th row takes part in the `iterations`
+/// steps.
+SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
+                                      const ImageSimilarity& start, const std::vector<float>& taper,
+                                      int iterations, int stride);
+
+}  // namespace oefmt

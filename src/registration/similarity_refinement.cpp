@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "oefmt/registration/similarity_refinement.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "oefmt/error.h"
+
+namespace oefmt {
+namespace {
+
+// Smoothing before the gradients [px]: a lens-sharp frame has gradients only a pixel wide, which
+// a warp off by a pixel at the image's edge no longer overlaps.
+constexpr double kSmoothingSigma = 1.0;
+
+// Tukey's biweight threshold in robust sigmas (95 % efficiency on Gaussian residuals): a pixel
+// of another depth layer, which moves by pixels more than the followed one, counts for nothing.
+constexpr double kTukey = 4.685;
+
+// Steps below these count as converged [rad, ln, px].
+constexpr double kAngleTolerance = 1e-5;
+constexpr double kShiftTolerance = 1e-3;
+
+// Parameters: rotation, log zoom, shift x, shift y, gain, bias.
+constexpr int kParameters = 6;
+using Normal = cv::Matx<double, kParameters, kParameters>;
+using Vector = cv::Vec<double, kParameters>;
+
+// The intensity residual of one pixel of the newer frame against the warped older one, and the
+// symmetric gradient (the mean of both frames', which converges in fewer steps than either).
+struct PixelResidual {
+  bool inside = false;
+  double r = 0.0, gx = 0.0, gy = 0.0, a = 0.0;
+};
+
+// The older frame's bilinear interpolant and its exact derivatives at (x, y).
+bool bilinear(const cv::Mat1f& image, double x, double y, double& value, double& dx, double& dy) {
+  if (!(x >= 1.0 && y >= 1.0 && x < image.cols - 2.0 && y < image.rows - 2.0)) return false;
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double tx = x - x0, ty = y - y0;
+  const float* r0 = image[y0];
+  const float* r1 = image[y0 + 1];
+  const double a00 = r0[x0], a01 = r0[x0 + 1], a10 = r1[x0], a11 = r1[x0 + 1];
+  const double top = a00 + tx * (a01 - a00), bottom = a10 + tx * (a11 - a10);
+  value = top + ty * (bottom - top);
+  dx = (1.0 - ty) * (a01 - a00) + ty * (a11 - a10);
+  dy = bottom - top;
+  return true;
+}
+
+// The motion as the inverse map of the newer frame's pixels into the older one's.
+struct InverseMap {
+  double c, tx, ty, i00, i01, i10, i11;
+  InverseMap(const ImageSimilarity& m, int n) : c(n / 2) {
+    const double s = std::exp(m.log_zoom);
+    const double cs = std::cos(m.rotation), sn = std::sin(m.rotation);
+    // A(c + M^-1 (x - d - c)), M = s R(theta), R = [cos sin; -sin cos] (y down, counter-clockwise
+    // on screen).
+    i00 = cs / s, i01 = -sn / s, i10 = sn / s, i11 = cs / s;
+    tx = m.translation.x;
+    ty = m.translation.y;
+  }
+};
+
+PixelResidual residualAt(const cv::Mat1f& older, const cv::Mat1f& newer, const InverseMap& map,
+                         double gain, double bias, int x, int y) {
+  PixelResidual p;
+  const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
+  double a = 0.0, ax = 0.0, ay = 0.0;
+  if (!bilinear(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a, ax, ay)) {
+    return p;
+  }
+  const float* row = newer[y];
+  // The older frame's gradient at the source point maps to the newer's by M^-T = [i00 i10; i01 i11].
+  p.gx = 0.5 * (gain * (map.i00 * ax + map.i10 * ay) + 0.5 * (row[x + 1] - row[x - 1]));
+  p.gy = 0.5 * (gain * (map.i01 * ax + map.i11 * ay) + 0.5 * (newer(y + 1, x) - newer(y - 1, x)));
+  p.r = row[x] - (gain * a + bias);
+  p.a = a;
+  p.inside = true;
+  return p;
+}
+
+// Robust sigma (1.4826 x the median absolute residual) over every `stride`-th pixel inside both
+// frames; negative when too few are.
+double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+                   const ImageSimilarity& motion, double gain, double bias, int stride,
+                   std::vector<float>& scratch, int* count) {
+  const int n = newer.rows;
+  const InverseMap map(motion, n);
+  scratch.clear();
+  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
+    if (!(taper[y] > 0.0f)) continue;
+    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
+      if (!(taper[x] > 0.0f)) continue;
+      const PixelResidual p = residualAt(older, newer, map, gain, bias, x, y);
+      if (p.inside) scratch.push_back(static_cast<float>(std::fabs(p.r)));
+    }
+  }
+  if (count != nullptr) *count = static_cast<int>(scratch.size());
+  if (scratch.size() < kParameters * 10u) return -1.0;
+  auto middle = scratch.begin() + scratch.size() / 2;
+  std::nth_element(scratch.begin(), middle, scratch.end());
+  return 1.4826 * *middle;
+}
+
+}  // namespace
+
+RefinementImage makeRefinementImage(const cv::Mat1f& grey) {
+  RefinementImage image;
+  if (grey.empty()) return image;
+  cv::GaussianBlur(grey, image.smooth, cv::Size(5, 5), kSmoothingSigma, kSmoothingSigma, cv::BORDER_REFLECT);
+  return image;
+}
+
+SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
+                                      const ImageSimilarity& start, const std::vector<float>& taper,
+                                      int iterations, int stride) {
+  const int n = newer.smooth.rows;
+  if (older.empty() || newer.empty() || older.smooth.size() != newer.smooth.size() ||
+      static_cast<int>(taper.size()) != n || newer.smooth.cols != n || stride < 1) {
+    throw InputError("refineSimilarity: frames or taper of different sizes");
+  }
+  SimilarityRefinement out;
+  out.similarity = start;
+  ImageSimilarity current = start;
+  double gain = 1.0, bias = 0.0;
+  std::vector<float> scratch;
+  // The residuals' scale before and after, on a sparser grid (the start's only sets the first
+  // step's robust weights).
+  const int sparse = 2 * stride;
+  double sigma = robustSigma(older.smooth, newer.smooth, taper, start, gain, bias, sparse, scratch, nullptr);
+  if (!(sigma > 0.0)) return out;
+  out.residual_start = sigma;
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    const InverseMap map(current, n);
+    Normal normal = Normal::zeros();
+    Vector rhs = Vector::all(0.0);
+    const double limit = kTukey * sigma;
+    scratch.clear();
+    for (int y = stride / 2 + 1; y < n - 1; y += stride) {
+      const float wy = taper[y];
+      if (!(wy > 0.0f)) continue;
+      for (int x = stride / 2 + 1; x < n - 1; x += stride) {
+        const float w_taper = wy * taper[x];
+        if (!(w_taper > 0.0f)) continue;
+        const PixelResidual p = residualAt(older.smooth, newer.smooth, map, gain, bias, x, y);
+        if (!p.inside) continue;
+        scratch.push_back(static_cast<float>(std::fabs(p.r)));
+        const double u = p.r / limit;
+        if (!(u * u < 1.0)) continue;
+        const double w = w_taper * (1.0 - u * u) * (1.0 - u * u);
+        // Residual motion u = (delta I + omega J)(x - p) + dd about p = c + d, J v = (v_y, -v_x):
+        // r ~ -g.u + d_gain A + d_bias.
+        const double px = x - map.tx - map.c, py = y - map.ty - map.c;
+        Vector j;
+        j[0] = -(p.gx * py - p.gy * px);  // omega
+        j[1] = -(p.gx * px + p.gy * py);  // delta (log zoom)
+        j[2] = -p.gx;
+        j[3] = -p.gy;
+        j[4] = p.a;
+        j[5] = 1.0;
+        for (int a = 0; a < kParameters; ++a) {
+          const double wj = w * j[a];
+          rhs[a] += wj * p.r;
+          for (int b = a; b < kParameters; ++b) normal(a, b) += wj * j[b];
+        }
+      }
+    }
+    // The next step's scale: this pass's residuals (before its step).
+    if (scratch.size() < kParameters * 10u) return out;
+    auto middle = scratch.begin() + scratch.size() / 2;
+    std::nth_element(scratch.begin(), middle, scratch.end());
+    if (!(*middle > 0.0f)) return out;
+    sigma = 1.4826 * *middle;
+    for (int a = 0; a < kParameters; ++a) {
+      for (int b = 0; b < a; ++b) normal(a, b) = normal(b, a);
+    }
+    Vector step;
+    if (!cv::solve(normal, rhs, step, cv::DECOMP_CHOLESKY)) return out;
+    current.rotation += step[0];
+    current.log_zoom += step[1];
+    current.translation.x += step[2];
+    current.translation.y += step[3];
+    gain += step[4];
+    bias += step[5];
+    out.converged = std::fabs(step[0]) < kAngleTolerance && std::fabs(step[1]) < kAngleTolerance &&
+                    std::fabs(step[2]) < kShiftTolerance && std::fabs(step[3]) < kShiftTolerance;
+  }
+  out.residual_end = robustSigma(older.smooth, newer.smooth, taper, current, gain, bias, sparse, scratch, &out.pixels);
+  out.similarity = current;
+  return out;
+}
+
+}  // namespace oefmt

@@ -1,0 +1,179 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// registration.refine_zoom: the log-polar surface reads a fraction of a bin towards the
+// nearest bin (a climb of a few per mille per frame reads as half of it); the refinement on the
+// intensities reads it whole.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "oefmt/error.h"
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/registration/registration.h"
+#include "oefmt/registration/similarity_refinement.h"
+#include "oefmt/registration/window.h"
+#include "support/fixtures.h"
+#include "support/flight_fixtures.h"
+
+namespace oefmt {
+namespace {
+
+constexpr int kN = 512;
+
+PairRegistration registerWith(bool refine, const test::ImagePair& pair) {
+  RegistrationConfig config;
+  config.size = kN;
+  config.fft_planning = FftPlanning::kEstimate;
+  config.refine_zoom = refine;
+  Registrar registrar(config);
+  return registrar.registerPair(registrar.analyse(pair.older), registrar.analyse(pair.newer),
+                                RegistrationMethod::kEnergyVectors);
+}
+
+double logZoomPerBin() {
+  RegistrationConfig config;
+  config.size = kN;
+  config.fft_planning = FftPlanning::kEstimate;
+  return Registrar(config).logZoomPerBin();
+}
+
+sim::ViewMotion motionOf(double zoom_bins, double rotation_bins, double log_zoom_per_bin) {
+  sim::ViewMotion motion;
+  motion.zoom = std::exp(zoom_bins * log_zoom_per_bin);
+  motion.rotation = rotation_bins * CV_PI / kN;
+  motion.shift = {9.5, -14.25};
+  return motion;
+}
+
+TEST(ZoomRefinement, SubBinZoomsAreReadWhole) {
+  const double per_bin = logZoomPerBin();
+  double unrefined_worst = 0.0;
+  for (double bins : {0.1, 0.2, 0.3, -0.25, 0.5, 1.3}) {
+    const auto pair = test::warpedPair(motionOf(bins, 0.0, per_bin), kN, 5);
+    const PairRegistration refined = registerWith(true, pair);
+    const PairRegistration plain = registerWith(false, pair);
+    ASSERT_EQ(refined.status, RegistrationStatus::kOk) << bins;
+    ASSERT_EQ(plain.status, RegistrationStatus::kOk) << bins;
+    EXPECT_TRUE(refined.zoom_refined) << bins;
+    EXPECT_FALSE(plain.zoom_refined) << bins;
+    EXPECT_NEAR(std::log(refined.zoom) / per_bin, bins, 0.03) << bins;
+    // The rotation and the translation stay the spectral registration's.
+    EXPECT_DOUBLE_EQ(refined.rotation, plain.rotation) << bins;
+    EXPECT_DOUBLE_EQ(refined.translation.x, plain.translation.x) << bins;
+    EXPECT_DOUBLE_EQ(refined.translation.y, plain.translation.y) << bins;
+    unrefined_worst = std::max(unrefined_worst, std::fabs(std::log(plain.zoom) / per_bin - bins));
+  }
+  // The premise: without the refinement some zoom is read a tenth of a bin off.
+  EXPECT_GT(unrefined_worst, 0.1);
+}
+
+TEST(ZoomRefinement, ARotationDoesNotBiasTheZoom) {
+  // The rotation is refined along with the zoom (and not taken): a sub-bin turn the surface
+  // reads short leaves the zoom right.
+  const double per_bin = logZoomPerBin();
+  for (double rotation_bins : {0.15, -0.35, 2.6}) {
+    const auto pair = test::warpedPair(motionOf(0.2, rotation_bins, per_bin), kN, 6);
+    const PairRegistration refined = registerWith(true, pair);
+    ASSERT_EQ(refined.status, RegistrationStatus::kOk) << rotation_bins;
+    EXPECT_TRUE(refined.zoom_refined) << rotation_bins;
+    EXPECT_NEAR(std::log(refined.zoom) / per_bin, 0.2, 0.03) << rotation_bins;
+    EXPECT_NEAR(refined.rotation * kN / CV_PI, rotation_bins, 0.5) << rotation_bins;
+  }
+}
+
+TEST(ZoomRefinement, TheRefinementReadsSubBinRotationsToo) {
+  // refineSimilarity itself: the rotation it reads is right on one plane (the registrar does not
+  // take it, see registration.cpp).
+  const double per_bin = logZoomPerBin();
+  const SeparableWindow window(kN, RegistrationConfig{}.taper_fraction);
+  for (double rotation_bins : {0.15, -0.35}) {
+    const auto pair = test::warpedPair(motionOf(0.2, rotation_bins, per_bin), kN, 6);
+    ImageSimilarity start;
+    start.translation = {9.5, -14.25};
+    const SimilarityRefinement refined =
+        refineSimilarity(makeRefinementImage(pair.older), makeRefinementImage(pair.newer), start,
+                         window.taper(), 3, 6);
+    EXPECT_NEAR(refined.similarity.rotation * kN / CV_PI, rotation_bins, 0.03) << rotation_bins;
+    EXPECT_NEAR(refined.similarity.log_zoom / per_bin, 0.2, 0.03) << rotation_bins;
+    EXPECT_LT(refined.residual_end, refined.residual_start) << rotation_bins;
+  }
+}
+
+TEST(ZoomRefinement, BrightnessChangeAndNoiseKeepTheZoom) {
+  const double per_bin = logZoomPerBin();
+  const double bins = 0.3;
+  test::ImagePair pair = test::warpedPair(motionOf(bins, 0.0, per_bin), kN, 7);
+  // Sensor noise of a fifth of the texture's contrast, 10 % more gain and a brighter level.
+  cv::Scalar mean, deviation;
+  cv::meanStdDev(pair.newer, mean, deviation);
+  cv::Mat1f noise(pair.newer.size());
+  cv::RNG rng(3);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 0.2 * deviation[0]);
+  pair.newer = pair.newer * 1.1 + noise + 0.1 * mean[0];
+  const PairRegistration refined = registerWith(true, pair);
+  ASSERT_EQ(refined.status, RegistrationStatus::kOk);
+  EXPECT_TRUE(refined.zoom_refined);
+  EXPECT_NEAR(std::log(refined.zoom) / per_bin, bins, 0.03);
+}
+
+// The climb an estimator reads over the first frames of a line climbing over flat natural ground
+// from 20 m, against the truth (both from the first frame) [m].
+struct ReadClimb {
+  double estimated = 0.0;
+  double truth = 0.0;
+};
+
+ReadClimb climbOverFlatGround(bool refine) {
+  sim::FlightOptions options;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.altitude = 20.0;
+  options.track.climb = 5.0;
+  options.flat = true;
+  options.texture_styles = {sim::TextureStyle::kNatural};
+  options.seed = 3;
+  const sim::FlightPlan plan = test::plannedFlight(options, 40);
+  const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
+  EstimatorConfig config = test::simulatedFlightConfig(plan);
+  config.registration.refine_zoom = refine;
+  Estimator estimator(config);
+  ReadClimb climb;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
+    if (e && k + 1 == frames.size()) climb.estimated = e->pose.z;
+  }
+  climb.truth = plan.poses.back().position[2] - plan.poses.front().position[2];
+  return climb;
+}
+
+TEST(ZoomRefinement, AClimbReadsItsWholeAltitudeChange) {
+  const ReadClimb refined = climbOverFlatGround(true);
+  const ReadClimb plain = climbOverFlatGround(false);
+  ASSERT_GT(refined.truth, 0.5);
+  // Within a tenth.
+  EXPECT_NEAR(refined.estimated / refined.truth, 1.0, 0.1) << refined.estimated << " m of " << refined.truth;
+  // The premise: without the refinement the climb reads as about half of itself.
+  EXPECT_LT(plain.estimated / plain.truth, 0.6) << plain.estimated << " m of " << plain.truth;
+}
+
+TEST(ZoomRefinement, FramesOfDifferentSizesAreAnError) {
+  const RefinementImage small = makeRefinementImage(cv::Mat1f(64, 64, 1.0f));
+  const RefinementImage large = makeRefinementImage(cv::Mat1f(128, 128, 1.0f));
+  const std::vector<float> taper(128, 1.0f);
+  EXPECT_THROW(refineSimilarity(small, large, ImageSimilarity{}, taper, 2, 1), InputError);
+  EXPECT_THROW(refineSimilarity(large, large, ImageSimilarity{}, std::vector<float>(64, 1.0f), 2, 1),
+               InputError);
+}
+
+TEST(ZoomRefinement, AFlatFrameLeavesTheStartUnchanged) {
+  // No gradient: the normal equations are singular and nothing is refined.
+  const RefinementImage flat = makeRefinementImage(cv::Mat1f(128, 128, 40.0f));
+  ImageSimilarity start;
+  start.log_zoom = 0.01;
+  start.rotation = 0.02;
+  const SimilarityRefinement refined = refineSimilarity(flat, flat, start, std::vector<float>(128, 1.0f), 3, 1);
+  EXPECT_DOUBLE_EQ(refined.similarity.log_zoom, 0.01);
+  EXPECT_DOUBLE_EQ(refined.similarity.rotation, 0.02);
+}
+
+}  // namespace
+}  // namespace oefmt
