@@ -82,6 +82,15 @@ PixelResidual residualAt(const cv::Mat1f& older, const cv::Mat1f& newer, const I
   return p;
 }
 
+// 1.4826 x the median of `magnitudes` (absolute residuals; reordered): the Gaussian sigma of the
+// pixels that fit; negative when too few pixels took part.
+double medianSigma(std::vector<float>& magnitudes) {
+  if (magnitudes.size() < kParameters * 10u) return -1.0;
+  auto middle = magnitudes.begin() + magnitudes.size() / 2;
+  std::nth_element(magnitudes.begin(), middle, magnitudes.end());
+  return 1.4826 * *middle;
+}
+
 // Robust sigma (1.4826 x the median absolute residual) over every `stride`-th pixel inside both
 // frames; negative when too few are.
 double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
@@ -99,10 +108,7 @@ double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::ve
     }
   }
   if (count != nullptr) *count = static_cast<int>(scratch.size());
-  if (scratch.size() < kParameters * 10u) return -1.0;
-  auto middle = scratch.begin() + scratch.size() / 2;
-  std::nth_element(scratch.begin(), middle, scratch.end());
-  return 1.4826 * *middle;
+  return medianSigma(scratch);
 }
 
 }  // namespace
@@ -169,11 +175,9 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       }
     }
     // The next step's scale: this pass's residuals (before its step).
-    if (scratch.size() < kParameters * 10u) return out;
-    auto middle = scratch.begin() + scratch.size() / 2;
-    std::nth_element(scratch.begin(), middle, scratch.end());
-    if (!(*middle > 0.0f)) return out;
-    sigma = 1.4826 * *middle;
+    const double next = medianSigma(scratch);
+    if (!(next > 0.0)) return out;
+    sigma = next;
     for (int a = 0; a < kParameters; ++a) {
       for (int b = 0; b < a; ++b) normal(a, b) = normal(b, a);
     }

@@ -136,7 +136,7 @@ struct EstimatorConfig {
   /// Z_0 in output units: initial_altitude, or 1 when unknown.
   double initialAltitudeOrOne() const { return initial_altitude > 0.0 ? initial_altitude : 1.0; }
   /// The registration parameters the mode runs with: the comparison modes (efmt, fmt) are the
-  /// published methods, without the rotation/zoom refinement.
+  /// published methods, without the zoom refinement (registration.refine_zoom).
   RegistrationConfig modeRegistration() const;
   /// Throws InputError naming the first invalid field.
   void validate() const;

@@ -72,7 +72,7 @@ struct FrameSpectra {
   float mean = 0.0f;            ///< grey mean, subtracted before apodization
   int invalid_pixels = 0;       ///< non-finite input pixels that were replaced
   float noise_power = 0.0f;     ///< noisePower(spectrum) (0 without noise weighting)
-  RefinementImage refinement;   ///< smoothed grey and gradients (empty without the refinement)
+  RefinementImage refinement;   ///< smoothed grey for the zoom refinement (empty without it)
 
   bool empty() const { return grey.empty(); }
 };
