@@ -548,7 +548,19 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
                                std::vector<float>&& next_translation01, Estimate& est) {
   // Integrate, from the anchor if predictions were made while frames failed.
   if (anchor) integrator.restore(*anchor);
-  integrator.integrate(step, frame.stamp);
+  // The pose takes the step with the spread of the lengths it could also have had (the PMT
+  // stretch, the highest correlation peak) within the acceleration window: where they disagree
+  // by more than a layer's noise the choice between them (a depth layer, a periodic texture's
+  // alias) may be wrong, and the reported uncertainty says so. The next pair's reference keeps
+  // the step's own covariance: the next steps are measured against the chosen length, right or
+  // wrong, so the ambiguity belongs to the pose and not to the next ratio.
+  if (have01 && motion01.shift() > 0.0) {
+    std::vector<double> alternatives{cv::norm(est.registration12.translation)};
+    if (est.pmt12.valid) alternatives.push_back(est.pmt12.value * motion01.shift());
+    const double window = prior12 ? prior12->translation_radius : 0.0;
+    est.length_spread = detail::lengthSpread(step.shift(), alternatives, config.tracking.layer_gate, window);
+  }
+  integrator.integrate(detail::withAlongTrackSpread(step, est.length_spread), frame.stamp);
   est.step = step;
   est.state = TrackingState::kTracking;
   if (have01 && motion01.shift() > 0.0) est.lambda_t12 = step.shift() / motion01.shift();

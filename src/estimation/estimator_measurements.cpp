@@ -129,6 +129,29 @@ double alongTrackSigma(const PairMotion& m) {
   return std::sqrt(std::max(ux * ux * c(0, 0) + 2.0 * ux * uy * c(0, 1) + uy * uy * c(1, 1), 0.0));
 }
 
+double lengthSpread(double length, const std::vector<double>& alternatives, double layer_gate, double window) {
+  if (!(length > 0.0) || !std::isfinite(length)) return 0.0;
+  double spread = 0.0;
+  for (const double alternative : alternatives) {
+    if (!(alternative > 0.0) || !std::isfinite(alternative)) continue;
+    const double off = std::fabs(alternative - length);
+    if (off <= layer_gate * length) continue;
+    if (window > 0.0 && off > window) continue;
+    spread = std::max(spread, off);
+  }
+  return spread;
+}
+
+PairMotion withAlongTrackSpread(const PairMotion& motion, double spread) {
+  const double length = motion.shift();
+  if (!(spread > 0.0) || !(length > 0.0)) return motion;
+  PairMotion out = motion;
+  const double ux = motion.translation.x / length, uy = motion.translation.y / length;
+  const double v = spread * spread;
+  out.translation_covariance += cv::Matx22d(ux * ux * v, ux * uy * v, ux * uy * v, uy * uy * v);
+  return out;
+}
+
 PairMotion perInterval(const PairMotion& m, int gap) {
   if (gap <= 1) return m;
   PairMotion out = m;

@@ -30,6 +30,17 @@ StretchMatchOptions stretchOptions(const MatchingConfig& matching, double init, 
                                    double reference_bin);
 ShiftMatchOptions shiftOptions(const MatchingConfig& matching);
 
+/// The ambiguity of a step's length: the largest distance of an `alternatives` length (another
+/// reading of the same step: the PMT stretch, the highest correlation peak) from `length`, among
+/// those off it by more than `layer_gate` x length (closer ones are the same reading within the
+/// layers' noise) and within `window` of it (the acceleration window: further ones the vehicle
+/// cannot have flown; `window` <= 0: no window). 0 when every alternative agrees or is ruled out;
+/// non-positive or non-finite alternatives are ignored.
+double lengthSpread(double length, const std::vector<double>& alternatives, double layer_gate, double window);
+
+/// `motion` with `spread`^2 added to its translation covariance along its direction.
+PairMotion withAlongTrackSpread(const PairMotion& motion, double spread);
+
 /// What a pair's observations are related to: pair 0-1 of the window.
 struct Reference {
   cv::Point2d translation;          ///< d01 [px of frame 1]

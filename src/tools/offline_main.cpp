@@ -185,7 +185,7 @@ void writeDiagnosticsHeader(std::ostream& out) {
   out << "frame,stamp,state,degraded,theta_rad,zoom,phi_rad,rho_px,confidence,"
          "sigma_theta_rad,sigma_log_zoom,sigma_phi_rad,sigma_rho_px,"
          "pmt12,pmt12_sigma,pmt02,pmt02_sigma,pms12_bins,pms12_sigma,pms02_bins,pms02_sigma,"
-         "lambda_t12,lambda_t02,optimizer_status,optimizer_iterations,cost_initial,cost_final,"
+         "lambda_t12,lambda_t02,length_spread_px,optimizer_status,optimizer_iterations,cost_initial,cost_final,"
          "x,y,z,yaw,step_var_x,step_cov_xy,step_var_y,step_var_z,step_var_yaw,"
          "registration_ms,estimator_ms,total_ms\n";
 }
@@ -195,13 +195,13 @@ void writeDiagnosticsLine(std::ostream& out, const oefmt::Estimate& e) {
   char line[1024];
   std::snprintf(line, sizeof(line),
                 "%zu,%.9f,%s,%d,%.8f,%.8f,%.8f,%.5f,%.4f,%.8f,%.8f,%.8f,%.5f,"
-                "%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.6f,%.6f,%s,%d,%.6g,%.6g,"
+                "%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.6f,%.6f,%.4f,%s,%d,%.6g,%.6g,"
                 "%.6f,%.6f,%.6f,%.8f,%.6g,%.6g,%.6g,%.6g,%.6g,%.3f,%.3f,%.3f\n",
                 e.frame_index, e.stamp, oefmt::toString(e.state), e.degraded ? 1 : 0, r.rotation,
                 r.zoom, r.direction, r.shift, r.confidence, r.rotation_sigma, r.log_zoom_sigma,
                 r.direction_sigma, r.shift_sigma, e.pmt12.value, e.pmt12.sigma, e.pmt02.value,
                 e.pmt02.sigma, e.pms12.value, e.pms12.sigma, e.pms02.value, e.pms02.sigma,
-                e.lambda_t12, e.lambda_t02, oefmt::toString(e.loop.status), e.loop.iterations,
+                e.lambda_t12, e.lambda_t02, e.length_spread, oefmt::toString(e.loop.status), e.loop.iterations,
                 e.loop.initial_cost, e.loop.final_cost, e.pose.x, e.pose.y, e.pose.z, e.pose.yaw,
                 e.step_covariance(0, 0), e.step_covariance(0, 1), e.step_covariance(1, 1),
                 e.step_covariance(2, 2), e.step_covariance(3, 3), e.registration_ms, e.estimator_ms, e.total_ms);

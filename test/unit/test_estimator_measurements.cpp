@@ -122,5 +122,35 @@ TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
   EXPECT_DOUBLE_EQ(step.shift(), 12.0);
 }
 
+// A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose
+// highest peak agreed with it: one reading is another layer's, and the spread says by how much.
+TEST(LengthSpread, OtherReadingsInsideTheWindowWiden) {
+  EXPECT_NEAR(detail::lengthSpread(108.9, {108.9, 131.8}, 0.05, 40.0), 22.9, 1e-9);
+  // The largest of several; unbounded without a window.
+  EXPECT_NEAR(detail::lengthSpread(100.0, {90.0, 125.0, 101.0}, 0.05, 0.0), 25.0, 1e-9);
+  // Within the layers' noise (layer_gate) the readings agree.
+  EXPECT_DOUBLE_EQ(detail::lengthSpread(100.0, {104.9, 95.1}, 0.05, 40.0), 0.0);
+  // Beyond the acceleration window a reading is an alias the vehicle cannot have flown.
+  EXPECT_DOUBLE_EQ(detail::lengthSpread(100.0, {181.8}, 0.05, 40.0), 0.0);
+  EXPECT_NEAR(detail::lengthSpread(100.0, {181.8, 120.0}, 0.05, 40.0), 20.0, 1e-9);
+  // Nothing to compare: no length, or readings that are not lengths.
+  EXPECT_DOUBLE_EQ(detail::lengthSpread(0.0, {100.0}, 0.05, 40.0), 0.0);
+  EXPECT_DOUBLE_EQ(detail::lengthSpread(100.0, {0.0, -150.0, std::nan(""), INFINITY}, 0.05, 0.0), 0.0);
+  EXPECT_DOUBLE_EQ(detail::lengthSpread(100.0, {}, 0.05, 0.0), 0.0);
+}
+
+TEST(LengthSpread, WidensOnlyAlongTheStep) {
+  const double direction = 0.5;
+  PairMotion m;
+  m.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * 100.0;
+  m.translation_covariance = alongAcrossCovariance(direction, 0.5, 0.3);
+  const PairMotion wide = detail::withAlongTrackSpread(m, 20.0);
+  EXPECT_NEAR(detail::alongTrackSigma(wide), std::hypot(0.5, 20.0), 1e-9);
+  const cv::Vec2d across(-std::sin(direction), std::cos(direction));
+  EXPECT_NEAR((across.t() * wide.translation_covariance * across)(0), 0.09, 1e-9);
+  EXPECT_EQ(wide.translation, m.translation);
+  EXPECT_EQ(detail::withAlongTrackSpread(m, 0.0).translation_covariance, m.translation_covariance);
+}
+
 }  // namespace
 }  // namespace oefmt

@@ -78,6 +78,11 @@ struct Estimate {
   LoopSolution loop;      ///< optimizer report (status kSkipped when it did not run)
   double lambda_t12 = 0.0;  ///< |d12| / |d01| of the integrated motion
   double lambda_t02 = 0.0;  ///< |d02| / |d01| of the optimized 0-2 (0 without a loop)
+  /// How far [px] the other readings of the step's length (the PMT stretch, the highest
+  /// correlation peak) lay from the integrated one, where they disagreed by more than a layer's
+  /// noise within the acceleration window (detail::lengthSpread); added to the pose's covariance
+  /// along the step. 0 when they agree.
+  double length_spread = 0.0;
 
   double registration_ms = 0.0;  ///< spectra and registrations (efmt: with the multi-zoom profiles)
   double matching_ms = 0.0;      ///< pattern matching (part of estimator_ms)
