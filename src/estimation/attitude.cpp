@@ -47,6 +47,12 @@ Eigen::Matrix3d nadirFromOptical(const CameraTilt& tilt) {
   return flipX() * tiltRotation(tilt) * flipX();
 }
 
+Eigen::Vector2d opticalAxisInNadirView(const CameraTilt& tilt, double fx) {
+  const Eigen::Vector3d axis = nadirFromOptical(tilt) * Eigen::Vector3d::UnitZ();
+  if (!(axis.z() > 1e-6) || !std::isfinite(fx)) return Eigen::Vector2d::Zero();
+  return Eigen::Vector2d(fx * axis.x() / axis.z(), fx * axis.y() / axis.z());
+}
+
 Eigen::Quaterniond cameraBodyOrientation(double yaw, const CameraTilt& tilt) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * tiltRotation(tilt)).normalized();
 }

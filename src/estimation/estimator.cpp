@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/estimation/estimator.h"
+#include "oefmt/estimation/range_gate.h"
 
 #include <algorithm>
 #include <chrono>
@@ -650,6 +651,12 @@ void Estimator::rescale(double factor) {
 }
 
 double Estimator::shiftPerBin() const { return state_->registrar.shiftPerBin(); }
+
+std::optional<double> Estimator::centreDepthRatio(cv::Point2d beam) const {
+  const State& s = *state_;
+  if (!s.have01 || !s.f0 || !s.f1) return std::nullopt;
+  return oefmt::centreDepthRatio(s.f0->spectra.grey, s.f1->spectra.grey, s.motion01, beam);
+}
 double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
 
 bool Estimator::acceptsStamp(double stamp) const {

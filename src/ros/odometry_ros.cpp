@@ -273,6 +273,12 @@ std::optional<double> OdometryRos::verticalRangeAt(const InputFrame& frame, cons
   return verticalRange(ranges_, frame.stamp.toSec(), kRangeMatch, tilt);
 }
 
+cv::Point2d OdometryRos::beamAt(const std::optional<CameraTilt>& tilt) const {
+  if (!tilt || !nadir_) return {0.0, 0.0};  // a frame taken as level
+  const Eigen::Vector2d at = opticalAxisInNadirView(*tilt, estimator_fx_);
+  return {at.x(), at.y()};
+}
+
 bool OdometryRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   reset_requested_ = true;
   queue_.clear();
@@ -490,7 +496,7 @@ void OdometryRos::process(const InputFrame& frame) {
     // used.
     const std::optional<double> vertical = verticalRangeAt(frame, body_tilt_);
     if (vertical && estimate->state == TrackingState::kTracking) {
-      scale_votes_.push_back(rangeObservation(*estimator_, *estimate, *vertical));
+      scale_votes_.push_back(rangeObservation(*estimator_, *estimate, *vertical, beamAt(tilt)));
     }
     if (++scale_frames_ >= static_cast<int>(kRangeVoteFrames)) {
       scale_settled_ = true;
@@ -511,7 +517,7 @@ void OdometryRos::process(const InputFrame& frame) {
       scale_votes_.clear();
     }
   } else if (parameters_.use_range && estimator_->config().initial_altitude > 0.0) {
-    if (range_altitude_.update(*estimator_, *estimate, verticalRangeAt(frame, body_tilt_))) {
+    if (range_altitude_.update(*estimator_, *estimate, verticalRangeAt(frame, body_tilt_), beamAt(tilt))) {
       Estimate corrected = *estimate;
       corrected.pose = estimator_->pose();
       publish(frame, corrected);

@@ -8,6 +8,9 @@
 #include <cmath>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
+#include "oefmt/estimation/attitude.h"
 #include "oefmt/estimation/range_gate.h"
 
 namespace oefmt {
@@ -79,6 +82,100 @@ TEST(RangeGate, ScaleVoteFindsWhichLayerTheReadingsSaw) {
   EXPECT_NEAR(*rangeScale(flat), 10.0, 1e-9);
   // Too few readings fit: nothing.
   EXPECT_FALSE(rangeScale({{10.0, 1.0, {}}, {20.0, 1.0, {}}}).has_value());
+}
+
+// The vote when the layer below each reading is known (centreDepthRatio): readings of the roofs
+// (ratio 0.6 to the followed ground) can no longer pass for the ground's, even when most
+// readings see roofs and the energy vectors show the ground alone.
+TEST(RangeGate, ScaleVoteTakesTheLayerBelowTheCameraWhereItIsKnown) {
+  std::vector<RangeObservation> observations;
+  for (const double reading : {12.0, 12.1, 11.9, 20.0, 12.05}) {
+    RangeObservation o{reading, 1.0, {1.0}};
+    o.centre_ratio = reading < 15.0 ? 0.6 : 1.0;
+    observations.push_back(o);
+  }
+  ASSERT_TRUE(rangeScale(observations).has_value());
+  EXPECT_NEAR(*rangeScale(observations), 20.0, 0.2);
+  // Without it the roofs, most readings, would win.
+  for (RangeObservation& o : observations) o.centre_ratio = 0.0;
+  EXPECT_NEAR(*rangeScale(observations), 12.0, 0.2);
+  // The gate alike: a roof reading measures the ground's depth through its ratio only.
+  RangeGate gate(0.08, 15);
+  EXPECT_NEAR(*gate.measure(12.0, 20.0, {}, 0.6), 20.0, 1e-9);
+  EXPECT_FALSE(gate.measure(20.0, 20.0, {}, 0.6).has_value());
+}
+
+// A smooth random texture of n x n.
+cv::Mat1f texture(int n, int seed) {
+  cv::Mat1f image(n, n);
+  cv::RNG rng(seed);
+  rng.fill(image, cv::RNG::UNIFORM, 0.0, 255.0);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  return image;
+}
+
+// The newer frame of a pair over the ground moving by `ground` [px], with a roof nearer the camera
+// (moving by `roof`) covering a `roof_size` square centred at `roof_centre` of the newer frame.
+cv::Mat1f newerFrame(const cv::Mat1f& older, cv::Point2d ground, cv::Point2d roof, cv::Point roof_centre, int roof_size) {
+  const int n = older.rows;
+  cv::Mat1f newer;
+  cv::warpAffine(older, newer, cv::Matx23d(1, 0, ground.x, 0, 1, ground.y), older.size(), cv::INTER_LINEAR,
+                 cv::BORDER_REFLECT);
+  cv::Mat1f roofs;
+  cv::warpAffine(texture(n, 99), roofs, cv::Matx23d(1, 0, roof.x, 0, 1, roof.y), older.size(), cv::INTER_LINEAR,
+                 cv::BORDER_REFLECT);
+  const cv::Rect square(roof_centre.x - roof_size / 2, roof_centre.y - roof_size / 2, roof_size, roof_size);
+  if (roof_size > 0) roofs(square).copyTo(newer(square));
+  return newer;
+}
+
+TEST(CentreDepthRatio, TellsTheLayerBelowTheReading) {
+  const int n = 512;
+  cv::Mat1f older = texture(n, 1);
+  // The roof's texture is in the older frame too, where the roof was.
+  const cv::Point2d ground(30.0, 10.0), roof = ground * (1.0 / 0.625);
+  cv::Mat1f roof_texture = texture(n, 99);
+  const cv::Rect before(256 - 100 - static_cast<int>(std::lround(roof.x)), 256 - 100 - static_cast<int>(std::lround(roof.y)),
+                        200, 200);
+  roof_texture(before).copyTo(older(before));
+  const cv::Mat1f newer = newerFrame(older, ground, roof, {256, 256}, 200);
+  PairMotion motion;
+  motion.translation = ground;
+  const std::optional<double> below = centreDepthRatio(older, newer, motion);
+  ASSERT_TRUE(below.has_value());
+  EXPECT_NEAR(*below, 0.625, 0.01);
+  // Beside the roof, the ground.
+  const std::optional<double> beside = centreDepthRatio(older, newer, motion, {0.0, -170.0});
+  ASSERT_TRUE(beside.has_value());
+  EXPECT_NEAR(*beside, 1.0, 0.01);
+  // A tilted camera's beam (opticalAxisInNadirView) reads beside the centre: 10 deg of roll at
+  // fx 443 px is 78 px.
+  CameraTilt tilt;
+  tilt.roll = 10.0 * M_PI / 180.0;
+  const Eigen::Vector2d at = opticalAxisInNadirView(tilt, 443.0);
+  EXPECT_NEAR(at.norm(), 443.0 * std::tan(tilt.roll), 1e-6);
+  EXPECT_NEAR(opticalAxisInNadirView(CameraTilt{}, 443.0).norm(), 0.0, 1e-12);
+}
+
+TEST(CentreDepthRatio, NothingWhenItCannotBeTold) {
+  const int n = 512;
+  const cv::Mat1f older = texture(n, 1);
+  const cv::Mat1f newer = newerFrame(older, {30.0, 10.0}, {30.0, 10.0}, {256, 256}, 0);
+  PairMotion motion;
+  motion.translation = {30.0, 10.0};
+  // A flat centre: no peak stands out of the noise.
+  const cv::Mat1f flat(n, n, 128.0f);
+  EXPECT_FALSE(centreDepthRatio(flat, flat, motion).has_value());
+  // Unrelated frames.
+  EXPECT_FALSE(centreDepthRatio(older, texture(n, 7), motion).has_value());
+  // The beam's patch outside the frame, no motion, frames of different sizes, a non-finite beam.
+  EXPECT_FALSE(centreDepthRatio(older, newer, motion, {300.0, 0.0}).has_value());
+  EXPECT_FALSE(centreDepthRatio(older, newer, PairMotion()).has_value());
+  EXPECT_FALSE(centreDepthRatio(older, texture(256, 1), motion).has_value());
+  EXPECT_FALSE(centreDepthRatio(older, newer, motion, {std::nan(""), 0.0}).has_value());
+  // The same ground everywhere: ratio 1.
+  ASSERT_TRUE(centreDepthRatio(older, newer, motion).has_value());
+  EXPECT_NEAR(*centreDepthRatio(older, newer, motion), 1.0, 0.01);
 }
 
 }  // namespace

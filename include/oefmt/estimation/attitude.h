@@ -23,6 +23,11 @@ struct CameraTilt {
   double pitch = 0.0;  ///< [rad]
 };
 
+/// Where the tilted camera's optical axis meets the virtual nadir camera's frame, relative to its
+/// principal point [px], for a virtual camera of focal length `fx` [px]: the point a rangefinder
+/// aligned with the camera reads. Zero for a level camera.
+Eigen::Vector2d opticalAxisInNadirView(const CameraTilt& tilt, double fx);
+
 /// The tilt of a camera whose optical frame turns into the world by `world_from_optical`.
 CameraTilt cameraTilt(const Eigen::Matrix3d& world_from_optical);
 

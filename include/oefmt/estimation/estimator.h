@@ -151,6 +151,10 @@ class Estimator {
   void rescale(double factor);
   /// The altitude above the reference plane now (output units).
   double altitude() const;
+  /// centreDepthRatio() (range_gate.h) of the pair the last tracked frame closed, at `beam` [px
+  /// from the frame's centre]: which depth layer lies below a rangefinder. Nothing before a pair
+  /// or when it cannot be told.
+  std::optional<double> centreDepthRatio(cv::Point2d beam = {0.0, 0.0}) const;
 
   /// The camera's turn about the vertical from the previous frame to the next one pushed, as a
   /// gyro measured it [rad, counter-clockwise seen from above], and its standard deviation: in

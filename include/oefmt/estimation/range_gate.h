@@ -31,7 +31,10 @@ class RangeGate {
   /// `vertical`: the reading turned vertical (range times the cosine of the tilt) [m];
   /// `predicted`: the estimator's altitude [m]; `depth_ratios`: the layers' c_l (depthRatios()).
   /// The altitude above the reference plane the reading measures, or nothing.
-  std::optional<double> measure(double vertical, double predicted, const std::vector<double>& depth_ratios = {});
+  /// `centre_ratio` (> 0): the layer below the camera is known (centreDepthRatio()); only its
+  /// ratio is tried.
+  std::optional<double> measure(double vertical, double predicted, const std::vector<double>& depth_ratios = {},
+                                double centre_ratio = 0.0);
 
   long accepted() const { return accepted_; }
   long refused() const { return refused_; }
@@ -53,9 +56,11 @@ class RangeAltitude {
   /// known [rad] (a step of length L may climb or descend L times it unseen by the images' zoom).
   explicit RangeAltitude(double reading_sigma = 0.05, double attitude_sigma = 0.5 * M_PI / 180.0);
 
-  /// After `estimator` gave `estimate` for a frame: its reading (nothing without one). True when
-  /// the reading corrected the altitude; the estimator's pose() is then the corrected one.
-  bool update(Estimator& estimator, const Estimate& estimate, std::optional<double> vertical);
+  /// After `estimator` gave `estimate` for a frame: its reading (nothing without one), read at
+  /// `beam` (see centreDepthRatio()). True when the reading corrected the altitude; the
+  /// estimator's pose() is then the corrected one.
+  bool update(Estimator& estimator, const Estimate& estimate, std::optional<double> vertical,
+              cv::Point2d beam = {0.0, 0.0});
 
   const RangeGate& gate() const { return gate_; }
 
@@ -66,6 +71,21 @@ class RangeAltitude {
   double last_x_ = 0.0, last_y_ = 0.0;  // where the altitude was last measured
 };
 
+/// The depth ratio c = (the followed layer's shift) / (the shift at the image centre) of a pair:
+/// which layer a downward rangefinder, which reads the surface below the camera, sees. `older`
+/// and `newer` are the pair's N x N grey frames and `motion` the pair's motion as the estimator
+/// integrated it (the followed layer's). The newer frame's centre patch (N / 4 wide), moved by
+/// the followed translation, is phase-correlated with the older frame's turned and zoomed into
+/// it: what is left is the centre's own shift beyond the followed layer's. Nothing when the
+/// frames do not fit, the motion is below a pixel, a patch leaves its frame, or the correlation
+/// peak does not stand out of the noise (three times the largest value a patch of unrelated
+/// content reaches): a low-texture centre, or a centre whose shift differs from the followed
+/// layer's by more than half a patch.
+/// `beam`: where the reading lies in the newer frame, relative to its centre [px]
+/// (opticalAxisInNadirView() for a levelled tilted frame; zero for a level camera).
+std::optional<double> centreDepthRatio(const cv::Mat1f& older, const cv::Mat1f& newer, const PairMotion& motion,
+                                       cv::Point2d beam = {0.0, 0.0});
+
 /// How many frames' readings vote which layer the rangefinder saw before the scale is taken from
 /// them (rangeScale): oefmt_offline runs them ahead, the node rescales after them.
 inline constexpr std::size_t kRangeVoteFrames = 20;
@@ -75,11 +95,16 @@ struct RangeObservation {
   double vertical = 0.0;              ///< the reading turned vertical [m]
   double predicted = 0.0;             ///< the estimator's altitude then (any consistent unit)
   std::vector<double> depth_ratios;   ///< depthRatios() of that frame
+  /// centreDepthRatio() of that frame, the layer below the camera (0: not measured). Where it is
+  /// known the reading is taken as that layer's, and depth_ratios are not consulted.
+  double centre_ratio = 0.0;
 };
 
 /// The observation of a reading for the frame `estimator` just gave `estimate` for: the
-/// estimator's altitude and the depth ratios of that frame's layers.
-RangeObservation rangeObservation(const Estimator& estimator, const Estimate& estimate, double vertical);
+/// estimator's altitude, the depth ratios of that frame's layers and the layer below the reading
+/// at `beam` (see centreDepthRatio()).
+RangeObservation rangeObservation(const Estimator& estimator, const Estimate& estimate, double vertical,
+                                  cv::Point2d beam = {0.0, 0.0});
 
 /// The factor that turns the estimator's altitudes into the reference plane's metric depth, from
 /// the first frames' readings, whichever layer each read: every reading proposes one factor per

@@ -77,6 +77,9 @@ class OdometryRos {
   std::optional<double> gyroTurn(double from, double to);
   /// The rangefinder's reading at the frame, vertical (nothing without one near the stamp).
   std::optional<double> verticalRangeAt(const InputFrame& frame, const std::optional<CameraTilt>& tilt);
+  /// Where the rangefinder (aligned with the camera) reads in the working frame, levelled with the
+  /// camera's `tilt` [px from its centre]: zero when the frame was not levelled.
+  cv::Point2d beamAt(const std::optional<CameraTilt>& tilt) const;
   bool resetService(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   /// Stamps the frame from its message header and hands it to the worker.
   void enqueue(InputFrame frame, const std_msgs::Header& header);
