@@ -7,7 +7,8 @@ oefmt_offline in oefmt mode with and without them, and prints one row per flight
 
   level        ATE of the level twin (similarity alignment in x-y)
   IMU + range  ATE, and the metric trajectory's scale error: |scale - 1| of the similarity
-               alignment, and the ATE of a rigid alignment (no scale)
+               alignment, the path length's error (no alignment: the estimate's 3-D path over
+               the truth's, on the frames both have) and the ATE of a rigid alignment (no scale)
   IMU only     ATE with the IMU and without the rangefinder (--no-range), and its ratio to level;
                the same with an exact IMU attitude (a second render whose imu.txt has no
                attitude error: what the levelling itself costs)
@@ -17,6 +18,7 @@ oefmt_offline in oefmt mode with and without them, and prints one row per flight
 """
 import argparse
 import json
+import math
 import os
 import subprocess
 import sys
@@ -64,6 +66,25 @@ def evaluate(tools, trajectory, truth, rigid=False):
     return json.loads(run(command).strip().splitlines()[-1])
 
 
+def read_tum(path):
+    poses = {}
+    with open(path) as lines:
+        for line in lines:
+            fields = line.split()
+            if fields and not fields[0].startswith("#"):
+                poses[round(float(fields[0]), 3)] = tuple(float(v) for v in fields[1:4])
+    return poses
+
+
+def path_length_error(trajectory, truth):
+    """|L_estimate / L_truth - 1| of the 3-D paths over the frames both have (matched by stamp)."""
+    estimate, reference = read_tum(trajectory), read_tum(truth)
+    stamps = sorted(set(estimate) & set(reference))
+    def length(poses):
+        return sum(math.dist(poses[a], poses[b]) for a, b in zip(stamps, stamps[1:]))
+    return abs(length(estimate) / length(reference) - 1.0)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--tools", default=os.path.join(HERE, "..", "build", "devel", "lib", "oefmt"))
@@ -92,17 +113,20 @@ def main():
         neither = evaluate(args.tools, offline(args.tools, tilted, os.path.join(tilted, "neither.tum"),
                                                "--no-imu", "--no-range"), truth)
         rows.append({"name": name, "what": what, "level": level_ate, "full": full_sim["ate"]["rmse"],
-                     "scale_error": abs(full_sim["scale"] - 1.0), "rigid": full_rigid["ate"]["rmse"],
+                     "scale_error": abs(full_sim["scale"] - 1.0), "path_error": path_length_error(full, truth),
+                     "rigid": full_rigid["ate"]["rmse"],
                      "imu": imu["ate"]["rmse"], "heading_max": imu["heading_steps"]["max_deg"],
                      "imu_exact": imu_exact["ate"]["rmse"],
                      "neither": neither["ate"]["rmse"]})
-    header = ["flight", "level ATE [m]", "IMU + range: ATE [m]", "scale error [%]", "rigid ATE [m]",
+    header = ["flight", "level ATE [m]", "IMU + range: ATE [m]", "scale error [%]", "path length error [%]",
+              "rigid ATE [m]",
               "IMU only: ATE [m]", "ratio to level", "max heading step error [deg]",
               "exact attitude: ATE [m]", "ratio to level", "neither: ATE [m]"]
     lines = []
     for r in rows:
         lines.append([f"{r['name']} ({r['what']})", f"{r['level']:.2f}", f"{r['full']:.2f}",
-                      f"{100 * r['scale_error']:.2f}", f"{r['rigid']:.2f}", f"{r['imu']:.2f}",
+                      f"{100 * r['scale_error']:.2f}", f"{100 * r['path_error']:.2f}", f"{r['rigid']:.2f}",
+                      f"{r['imu']:.2f}",
                       f"{r['imu'] / r['level']:.1f}", f"{r['heading_max']:.2f}", f"{r['imu_exact']:.2f}",
                       f"{r['imu_exact'] / r['level']:.1f}", f"{r['neither']:.1f}"])
     if args.markdown:
