@@ -513,14 +513,13 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
                       log_zoom_per_bin, double(gap12) / gap01, prior12 ? &*prior12 : nullptr, initial12);
   est.translation_use12 = obs12.translation_use;
   est.measured12 = initial12;
-  // The observations follow the layer the prediction points at (observe()), but the prediction's
-  // window is as wide as the vehicle's acceleration allows, and on a periodic texture another
-  // layer's peak can lie inside it and agree with pair 0-2's peak of that layer, which the loop
-  // then keeps: a step still off steady speed by more than tracking.layer_gate goes back to the
-  // followed layer (steadyLayerStep), with a prediction as without one.
+  // With a predicted translation the observations already follow the layer (observe()).
+  const bool predicted_translation = prior12 && prior12->translation_radius > 0.0;
   const auto followLayer = [&](const PairMotion& candidate) {
-    return detail::steadyLayerStep(candidate, reg12, translation01, ref.shift * gap12 / gap01, config,
-                                   shift_per_bin, double(gap12) / gap01);
+    return predicted_translation ? candidate
+                                 : detail::steadyLayerStep(candidate, reg12, translation01,
+                                                           ref.shift * gap12 / gap01, config,
+                                                           shift_per_bin, double(gap12) / gap01);
   };
   if (!usable02) return followLayer(initial12);  // no loop: the gated measurement
 
