@@ -93,6 +93,9 @@ CORPUS = [
     flight("line-parallax-yaw", "line, tops at 40 %, walls, heading on the track", "--track", "line",
            "--altitude", "20", "--levels", "8", "--walls", "--heading", "track", "--direction", "30",
            "--seed", "12"),
+    flight("line-parallax-s2", "the same line, another seed (roofs below most of its start)", "--track", "line",
+           "--altitude", "20", "--levels", "8", "--walls", "--heading", "track", "--direction", "30",
+           "--seed", "34"),
     # Textures.
     flight("circle-natural", "natural texture", "--texture-style", "natural", "--seed", "19"),
     flight("eight-natural-yaw", "figure-8, natural, heading on the track", "--track", "eight",
@@ -116,6 +119,7 @@ CORPUS = [
     # A multirotor without gimbal: leaning into its acceleration, with a wobble, and an IMU whose
     # attitude wanders (imu.txt: oefmt_offline levels every frame with it).
     flight("circle-tilted", "tilting multirotor, IMU", *TILTED, "--seed", "35"),
+    flight("circle-tilted-s2", "tilting multirotor, IMU, the default scene's seed", *TILTED),
     flight("eight-tilted-climb", "figure-8, tilting, climbing 8 m and back, IMU", "--track", "eight",
            "--climb", "8", *TILTED, "--seed", "36"),
     flight("line-tilted-climb", "line climbing 5 m, tilting, heading on the track, IMU", "--track", "line",
