@@ -651,13 +651,13 @@ void Estimator::rescale(double factor) {
 }
 
 double Estimator::shiftPerBin() const { return state_->registrar.shiftPerBin(); }
+double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
 
 std::optional<double> Estimator::centreDepthRatio(cv::Point2d beam) const {
   const State& s = *state_;
   if (!s.have01 || !s.f0 || !s.f1) return std::nullopt;
   return oefmt::centreDepthRatio(s.f0->spectra.grey, s.f1->spectra.grey, s.motion01, beam);
 }
-double Estimator::logZoomPerBin() const { return state_->registrar.logZoomPerBin(); }
 
 bool Estimator::acceptsStamp(double stamp) const {
   return std::isfinite(stamp) && stamp >= state_->last_stamp;

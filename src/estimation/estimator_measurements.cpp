@@ -146,9 +146,7 @@ PairMotion withAlongTrackSpread(const PairMotion& motion, double spread) {
   const double length = motion.shift();
   if (!(spread > 0.0) || !(length > 0.0)) return motion;
   PairMotion out = motion;
-  const double ux = motion.translation.x / length, uy = motion.translation.y / length;
-  const double v = spread * spread;
-  out.translation_covariance += cv::Matx22d(ux * ux * v, ux * uy * v, ux * uy * v, uy * uy * v);
+  out.translation_covariance += alongAcrossCovariance(motion.direction(), spread, 0.0);
   return out;
 }
 
