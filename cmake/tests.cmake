@@ -6,6 +6,7 @@ catkin_add_gtest(oefmt_tool_tests test/tools/test_bag_io.cpp test/tools/test_too
                  test/tools/test_debug_rendering.cpp test/tools/test_frame_source.cpp
                  test/tools/test_stamp_guard.cpp test/tools/test_frame_queue.cpp
                  test/tools/test_rectification.cpp test/tools/test_parameter_doc.cpp
+                 test/tools/test_diagnostics_doc.cpp src/tools/diagnostics_csv.cpp
                  src/tools/frame_source.cpp src/tools/bag_source.cpp src/tools/parameter_doc.cpp
                  test/support/gtest_main.cpp)
 if(TARGET oefmt_tool_tests)

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "command_line.h"
+#include "diagnostics_csv.h"
 #include "frame_source.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator.h"
@@ -50,6 +51,7 @@ struct Options {
   bool use_imu = true;
   bool use_range = true;
   bool quiet = false;
+  bool print_columns = false;
 };
 
 /// Reads the command line into `o`; returns the exit status when the tool is to stop here.
@@ -81,10 +83,13 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
                  "trajectory, TUM 't x y z qx qy qz qw' (t: a folder's timestamps.txt\n"
                  "[s], or the frame index without a usable one; a bag's header\n"
                  "stamps [s]); REP-103 world: x right, y up of the first image, z up")
-      ->type_name("FILE")
-      ->required();
-  app.add_option("--diagnostics", o.diagnostics, "one CSV line per frame: registration, matching, optimizer, timing")
       ->type_name("FILE");
+  app.add_option("--diagnostics", o.diagnostics,
+                 "one CSV line per frame: registration, matching, optimizer, pose,\n"
+                 "timing (doc/diagnostics.md describes every column)")
+      ->type_name("FILE");
+  app.add_flag("--diagnostics-columns", o.print_columns,
+               "print doc/diagnostics.md (the diagnostics file's columns) and stop");
   app.add_option("--config", o.config, "parameters (doc/parameters.md describes every key)")->type_name("FILE");
   app.add_option_function<std::string>(
          "--mode",
@@ -112,6 +117,7 @@ std::optional<int> parseArguments(int argc, char** argv, Options& o) {
   app.add_option("--max-frames", o.max_frames, "stop after N frames")->type_name("N");
   app.add_flag("--quiet", o.quiet, "no progress bar and no summary table");
   app.callback([&o] {
+    if (o.print_columns) return;
     oefmt::requireInput(o.images.empty() != o.bag.empty(), "give exactly one of --images and --bag");
     oefmt::requireInput(!o.output.empty(), "--output is required");
     oefmt::requireInput(o.altitude == -1.0 || o.altitude > 0.0, "--altitude must be > 0");
@@ -189,33 +195,6 @@ Eigen::Matrix3d cameraMountInImu(const Options& o, const std::string& imu_topic)
   return oefmt::downLookingMount();
 }
 
-void writeDiagnosticsHeader(std::ostream& out) {
-  out << "frame,stamp,state,degraded,theta_rad,zoom,phi_rad,rho_px,confidence,"
-         "sigma_theta_rad,sigma_log_zoom,sigma_phi_rad,sigma_rho_px,"
-         "pmt12,pmt12_sigma,pmt02,pmt02_sigma,pms12_bins,pms12_sigma,pms02_bins,pms02_sigma,"
-         "lambda_t12,lambda_t02,length_spread_px,optimizer_status,optimizer_iterations,cost_initial,cost_final,"
-         "x,y,z,yaw,step_var_x,step_cov_xy,step_var_y,step_var_z,step_var_yaw,"
-         "registration_ms,estimator_ms,total_ms\n";
-}
-
-void writeDiagnosticsLine(std::ostream& out, const oefmt::Estimate& e) {
-  const oefmt::PairRegistration& r = e.registration12;
-  char line[1024];
-  std::snprintf(line, sizeof(line),
-                "%zu,%.9f,%s,%d,%.8f,%.8f,%.8f,%.5f,%.4f,%.8f,%.8f,%.8f,%.5f,"
-                "%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f,%.4f,%.6f,%.6f,%.4f,%s,%d,%.6g,%.6g,"
-                "%.6f,%.6f,%.6f,%.8f,%.6g,%.6g,%.6g,%.6g,%.6g,%.3f,%.3f,%.3f\n",
-                e.frame_index, e.stamp, oefmt::toString(e.state), e.degraded ? 1 : 0, r.rotation,
-                r.zoom, r.direction, r.shift, r.confidence, r.rotation_sigma, r.log_zoom_sigma,
-                r.direction_sigma, r.shift_sigma, e.pmt12.value, e.pmt12.sigma, e.pmt02.value,
-                e.pmt02.sigma, e.pms12.value, e.pms12.sigma, e.pms02.value, e.pms02.sigma,
-                e.lambda_t12, e.lambda_t02, e.length_spread, oefmt::toString(e.loop.status), e.loop.iterations,
-                e.loop.initial_cost, e.loop.final_cost, e.pose.x, e.pose.y, e.pose.z, e.pose.yaw,
-                e.step_covariance(0, 0), e.step_covariance(0, 1), e.step_covariance(1, 1),
-                e.step_covariance(2, 2), e.step_covariance(3, 3), e.registration_ms, e.estimator_ms, e.total_ms);
-  out << line;
-}
-
 double percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0.0;
   std::sort(values.begin(), values.end());
@@ -229,6 +208,10 @@ int main(int argc, char** argv) {
   oefmt::useDefaultFftWisdom();
   Options options;
   if (const std::optional<int> exit_status = parseArguments(argc, argv, options)) return *exit_status;
+  if (options.print_columns) {
+    std::fputs(oefmt::diagnosticsMarkdown().c_str(), stdout);
+    return 0;
+  }
   std::ofstream trajectory, diagnostics;
   long frames = 0, not_tracked = 0, restarts = 0, fallbacks = 0;
   std::vector<double> frame_ms;
@@ -352,7 +335,7 @@ int main(int argc, char** argv) {
     if (!options.diagnostics.empty()) {
       diagnostics.open(options.diagnostics);
       if (!diagnostics) throw oefmt::InputError("cannot write '" + options.diagnostics + "'");
-      writeDiagnosticsHeader(diagnostics);
+      diagnostics << oefmt::diagnosticsCsvHeader();
     }
     if (!options.quiet) {
       std::fprintf(stderr, "oefmt_offline: %s, mode %s\n", source_text.c_str(), oefmt::toString(config.mode));
@@ -455,7 +438,7 @@ int main(int argc, char** argv) {
       }
       trajectory << (frame.tilt ? oefmt::toTumLine(estimate->pose, *frame.tilt) : oefmt::toTumLine(estimate->pose))
                  << '\n';
-      if (diagnostics.is_open()) writeDiagnosticsLine(diagnostics, *estimate);
+      if (diagnostics.is_open()) diagnostics << oefmt::diagnosticsCsvLine(*estimate);
       progress.update(static_cast<size_t>(frames));
     }
     progress.finish();

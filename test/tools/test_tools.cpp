@@ -289,6 +289,49 @@ TEST(Tools, OfflineUndistortsFoldersAndBagsAlike) {
   EXPECT_GT(largestDifference(poses(dir / "raw.tum"), poses(dir / "folder.tum")), 0.1);
 }
 
+// The diagnostics file has the documented header and, per frame, the pose the trajectory holds.
+TEST(Tools, OfflineDiagnosticsHoldThePosesOfTheTrajectory) {
+  TempDir dir;
+  const ToolRun simulate = run(dir, std::string(OEFMT_SIMULATE) + " --quiet --size 128 --track line --frames 6 --length 10 " +
+                                    "--seed 4 " + (dir / "flight"));
+  ASSERT_EQ(simulate.status, 0) << simulate.err;
+  std::ofstream(dir / "size128.yaml") << "registration:\n   size: 128\n";
+  const ToolRun offline = run(dir, std::string(OEFMT_OFFLINE) + " --quiet --config " + (dir / "size128.yaml") +
+                                       " --images " + (dir / "flight") + " --output " + (dir / "x.tum") +
+                                       " --diagnostics " + (dir / "x.csv"));
+  ASSERT_EQ(offline.status, 0) << offline.err;
+  const ToolRun columns = run(dir, std::string(OEFMT_OFFLINE) + " --diagnostics-columns");
+  ASSERT_EQ(columns.status, 0) << columns.err;
+  std::istringstream csv(readFile(dir / "x.csv"));
+  std::string header;
+  ASSERT_TRUE(std::getline(csv, header));
+  std::vector<std::string> names;
+  std::istringstream fields(header);
+  for (std::string name; std::getline(fields, name, ',');) {
+    names.push_back(name);
+    EXPECT_NE(columns.out.find("| `" + name + "` |"), std::string::npos) << name << " undocumented";
+  }
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+  };
+  ASSERT_LT(column("x"), names.size());
+  ASSERT_LT(column("y"), names.size());
+  const StampedTrajectory trajectory = readTum(dir / "x.tum");
+  ASSERT_EQ(trajectory.size(), 6u);
+  std::size_t lines = 0;
+  for (std::string line; std::getline(csv, line); ++lines) {
+    std::vector<std::string> values;
+    std::istringstream cells(line);
+    for (std::string value; std::getline(cells, value, ',');) values.push_back(value);
+    ASSERT_EQ(values.size(), names.size()) << line;
+    ASSERT_LT(lines, trajectory.size());
+    EXPECT_NEAR(std::stod(values[column("x")]), trajectory[lines].position.x(), 1e-5) << line;
+    EXPECT_NEAR(std::stod(values[column("y")]), trajectory[lines].position.y(), 1e-5) << line;
+  }
+  EXPECT_EQ(lines, trajectory.size());
+  EXPECT_GT(std::fabs(trajectory.back().position.x()) + std::fabs(trajectory.back().position.y()), 0.1);  // it moved
+}
+
 // A calibration of another resolution is said in one line; an unusable cam_param.yaml stops the
 // run with one line naming the file and the problem (exit status 1).
 TEST(Tools, OfflineSaysHowTheCalibrationIsUsedAndRefusesUnusableOnes) {

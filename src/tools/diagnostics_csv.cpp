@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "diagnostics_csv.h"
+
+#include <cstdio>
+
+namespace oefmt {
+namespace {
+
+template <typename... Args>
+std::string format(const char* pattern, Args... args) {
+  char text[64];
+  std::snprintf(text, sizeof(text), pattern, args...);
+  return text;
+}
+
+const PairRegistration& pair12(const Estimate& e) { return e.registration12; }
+
+}  // namespace
+
+const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
+  static const std::vector<DiagnosticsColumn> columns = {
+      {"frame", "", "0-based index of the frame in the input",
+       [](const Estimate& e) { return format("%zu", e.frame_index); }},
+      {"stamp", "s", "the frame's time stamp", [](const Estimate& e) { return format("%.9f", e.stamp); }},
+      {"state", "",
+       "started (the origin), tracking (registered), predicted (extrapolated with the last motion), "
+       "held (the pose kept), restarted (the window starts again from this frame)",
+       [](const Estimate& e) { return std::string(toString(e.state)); }},
+      {"degraded", "", "1 when the pose did not come from a confident registration of this frame",
+       [](const Estimate& e) { return format("%d", e.degraded ? 1 : 0); }},
+      {"theta_rad", "rad", "pair 1-2's registered rotation (counter-clockwise on screen)",
+       [](const Estimate& e) { return format("%.8f", pair12(e).rotation); }},
+      {"zoom", "", "pair 1-2's registered zoom (the newer frame looks this much larger)",
+       [](const Estimate& e) { return format("%.8f", pair12(e).zoom); }},
+      {"phi_rad", "rad", "direction of pair 1-2's translation peak (image axes, y down)",
+       [](const Estimate& e) { return format("%.8f", pair12(e).direction); }},
+      {"rho_px", "px", "length of pair 1-2's translation peak (working image pixels)",
+       [](const Estimate& e) { return format("%.5f", pair12(e).shift); }},
+      {"confidence", "", "pair 1-2's registration confidence, 0 (unusable) to 1",
+       [](const Estimate& e) { return format("%.4f", pair12(e).confidence); }},
+      {"sigma_theta_rad", "rad", "sigma of theta_rad from the peak's width",
+       [](const Estimate& e) { return format("%.8f", pair12(e).rotation_sigma); }},
+      {"sigma_log_zoom", "", "sigma of ln(zoom) from the peak's width",
+       [](const Estimate& e) { return format("%.8f", pair12(e).log_zoom_sigma); }},
+      {"sigma_phi_rad", "rad", "sigma of phi_rad from the peak's width",
+       [](const Estimate& e) { return format("%.8f", pair12(e).direction_sigma); }},
+      {"sigma_rho_px", "px", "sigma of rho_px from the peak's width",
+       [](const Estimate& e) { return format("%.5f", pair12(e).shift_sigma); }},
+      {"pmt12", "", "stretch of pair 1-2's translation energy against pair 0-1's (about 1 at steady speed)",
+       [](const Estimate& e) { return format("%.6f", e.pmt12.value); }},
+      {"pmt12_sigma", "", "sigma of ln(pmt12); 0 when no stretch was matched",
+       [](const Estimate& e) { return format("%.6f", e.pmt12.sigma); }},
+      {"pmt02", "", "stretch of pair 0-2's translation energy against pair 0-1's (about 2 at steady speed)",
+       [](const Estimate& e) { return format("%.6f", e.pmt02.value); }},
+      {"pmt02_sigma", "", "sigma of ln(pmt02); 0 when no stretch was matched",
+       [](const Estimate& e) { return format("%.6f", e.pmt02.sigma); }},
+      {"pms12_bins", "bins", "shift of pair 1-2's zoom energy against pair 0-1's (about 0 at a steady climb rate)",
+       [](const Estimate& e) { return format("%.4f", e.pms12.value); }},
+      {"pms12_sigma", "bins", "sigma of pms12_bins",
+       [](const Estimate& e) { return format("%.4f", e.pms12.sigma); }},
+      {"pms02_bins", "bins", "shift of pair 0-2's zoom energy against pair 0-1's",
+       [](const Estimate& e) { return format("%.4f", e.pms02.value); }},
+      {"pms02_sigma", "bins", "sigma of pms02_bins",
+       [](const Estimate& e) { return format("%.4f", e.pms02.sigma); }},
+      {"lambda_t12", "", "length of the integrated step over the previous one",
+       [](const Estimate& e) { return format("%.6f", e.lambda_t12); }},
+      {"lambda_t02", "", "length of the optimized pair 0-2 over the previous step (0 without a loop)",
+       [](const Estimate& e) { return format("%.6f", e.lambda_t02); }},
+      {"length_spread_px", "px",
+       "distance of the step's other length readings (PMT stretch, highest peak) from the integrated "
+       "length, added to the pose's covariance along the step; 0 when they agree",
+       [](const Estimate& e) { return format("%.4f", e.length_spread); }},
+      {"optimizer_status", "", "the three-frame loop: converged, fallback (the measurements stand) or skipped",
+       [](const Estimate& e) { return std::string(toString(e.loop.status)); }},
+      {"optimizer_iterations", "", "Levenberg-Marquardt iterations over all starting points",
+       [](const Estimate& e) { return format("%d", e.loop.iterations); }},
+      {"cost_initial", "", "the loop's cost at the winning start",
+       [](const Estimate& e) { return format("%.6g", e.loop.initial_cost); }},
+      {"cost_final", "", "the loop's cost at its solution",
+       [](const Estimate& e) { return format("%.6g", e.loop.final_cost); }},
+      {"x", "m", "position east of the first camera position (units of the initial altitude when it is unknown)",
+       [](const Estimate& e) { return format("%.6f", e.pose.x); }},
+      {"y", "m", "position north of the first camera position (same units)",
+       [](const Estimate& e) { return format("%.6f", e.pose.y); }},
+      {"z", "m", "height above the first camera position (same units)",
+       [](const Estimate& e) { return format("%.6f", e.pose.z); }},
+      {"yaw", "rad", "heading, counter-clockwise seen from above, 0 at the first frame",
+       [](const Estimate& e) { return format("%.8f", e.pose.yaw); }},
+      {"step_var_x", "m²", "variance of this frame's step along x (world frame, same units)",
+       [](const Estimate& e) { return format("%.6g", e.step_covariance(0, 0)); }},
+      {"step_cov_xy", "m²", "covariance of the step's x and y",
+       [](const Estimate& e) { return format("%.6g", e.step_covariance(0, 1)); }},
+      {"step_var_y", "m²", "variance of the step along y",
+       [](const Estimate& e) { return format("%.6g", e.step_covariance(1, 1)); }},
+      {"step_var_z", "m²", "variance of the step's height change",
+       [](const Estimate& e) { return format("%.6g", e.step_covariance(2, 2)); }},
+      {"step_var_yaw", "rad²", "variance of the step's turn",
+       [](const Estimate& e) { return format("%.6g", e.step_covariance(3, 3)); }},
+      {"registration_ms", "ms", "spectra and registrations of this frame (wall time)",
+       [](const Estimate& e) { return format("%.3f", e.registration_ms); }},
+      {"estimator_ms", "ms", "everything else: matching, optimizer, bookkeeping",
+       [](const Estimate& e) { return format("%.3f", e.estimator_ms); }},
+      {"total_ms", "ms", "the whole frame", [](const Estimate& e) { return format("%.3f", e.total_ms); }},
+  };
+  return columns;
+}
+
+std::string diagnosticsCsvHeader() {
+  std::string line;
+  for (const DiagnosticsColumn& c : diagnosticsColumns()) line += (line.empty() ? "" : ",") + std::string(c.name);
+  return line + "\n";
+}
+
+std::string diagnosticsCsvLine(const Estimate& estimate) {
+  std::string line;
+  bool first = true;
+  for (const DiagnosticsColumn& c : diagnosticsColumns()) {
+    if (!first) line += ',';
+    line += c.value(estimate);
+    first = false;
+  }
+  return line + "\n";
+}
+
+std::string diagnosticsMarkdown() {
+  std::string doc =
+      "<!-- Generated by `oefmt_offline --diagnostics-columns` from the column table in the code\n"
+      "     (src/tools/diagnostics_csv.cpp); a test compares this file with it. -->\n"
+      "# Per-frame diagnostics\n\n"
+      "`oefmt_offline --diagnostics FILE` writes one CSV line per frame, after a header line with\n"
+      "these column names. Pair 1-2 is the newest frame against the previous accepted one, pair 0-1\n"
+      "the step before it and pair 0-2 the loop's long pair (`doc/method.md`). Registration values\n"
+      "are the raw measurement of pair 1-2; the pose and the step covariance are what was\n"
+      "integrated. Values of a step that did not run (no loop, no pattern match, the first frame)\n"
+      "are 0.\n\n"
+      "| column | unit | meaning |\n|---|---|---|\n";
+  for (const DiagnosticsColumn& c : diagnosticsColumns()) {
+    doc += std::string("| `") + c.name + "` | " + c.unit + " | " + c.meaning + " |\n";
+  }
+  return doc;
+}
+
+}  // namespace oefmt
