@@ -67,6 +67,12 @@ bool RangeAltitude::update(Estimator& estimator, const Estimate& estimate, std::
   return true;
 }
 
+cv::Point2d beamInFrame(const std::optional<CameraTilt>& tilt, double fx) {
+  if (!tilt) return {0.0, 0.0};
+  const Eigen::Vector2d at = opticalAxisInNadirView(*tilt, fx);
+  return {at.x(), at.y()};
+}
+
 RangeObservation rangeObservation(const Estimator& estimator, const Estimate& estimate, double vertical,
                                   cv::Point2d beam) {
   RangeObservation observation;

@@ -274,9 +274,7 @@ std::optional<double> OdometryRos::verticalRangeAt(const InputFrame& frame, cons
 }
 
 cv::Point2d OdometryRos::beamAt(const std::optional<CameraTilt>& tilt) const {
-  if (!tilt || !nadir_) return {0.0, 0.0};  // a frame taken as level
-  const Eigen::Vector2d at = opticalAxisInNadirView(*tilt, estimator_fx_);
-  return {at.x(), at.y()};
+  return beamInFrame(nadir_ ? tilt : std::nullopt, estimator_fx_);  // without nadir_: taken as level
 }
 
 bool OdometryRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {

@@ -138,14 +138,6 @@ oefmt::FrameSpectra cloneSpectra(const oefmt::FrameSpectra& s) {
 // A reading belongs to a frame within this of its stamp [s].
 constexpr double kRangeMatch = 0.02;
 
-// Where a rangefinder aligned with the camera reads in a frame levelled with `tilt` [px from its
-// centre; zero for a level frame].
-cv::Point2d beamAt(const std::optional<oefmt::CameraTilt>& tilt, const oefmt::EstimatorConfig& config) {
-  if (!tilt) return {0.0, 0.0};
-  const Eigen::Vector2d at = oefmt::opticalAxisInNadirView(*tilt, config.working_fx);
-  return {at.x(), at.y()};
-}
-
 // A frame's reading, vertical (oefmt::verticalRange).
 std::optional<double> verticalRange(const std::vector<oefmt::RangeSample>& ranges, double stamp,
                                     const std::optional<oefmt::CameraTilt>& tilt) {
@@ -370,8 +362,8 @@ int main(int argc, char** argv) {
         replay.push_back(std::move(ahead));
         const std::optional<oefmt::Estimate> e = provisional->push(std::move(copy.spectra), copy.stamp);
         if (!e || !vertical) continue;
-        observations.push_back(
-            oefmt::rangeObservation(*provisional, *e, *vertical, beamAt(copy.tilt, provisional->config())));
+        const cv::Point2d beam = oefmt::beamInFrame(copy.tilt, provisional->config().working_fx);
+        observations.push_back(oefmt::rangeObservation(*provisional, *e, *vertical, beam));
       }
       if (provisional) {
         const double first = provisional->config().initial_altitude;
@@ -433,7 +425,7 @@ int main(int argc, char** argv) {
       if (estimate->loop.status == oefmt::OptimizerStatus::kFallback) ++fallbacks;
       if (!ranges.empty() && config.initial_altitude > 0.0 &&
           range_altitude.update(*estimator, *estimate, verticalRange(ranges, frame.stamp, frame.tilt),
-                                beamAt(frame.tilt, estimator->config()))) {
+                                oefmt::beamInFrame(frame.tilt, estimator->config().working_fx))) {
         estimate->pose = estimator->pose();
       }
       trajectory << (frame.tilt ? oefmt::toTumLine(estimate->pose, *frame.tilt) : oefmt::toTumLine(estimate->pose))

@@ -155,6 +155,10 @@ TEST(CentreDepthRatio, TellsTheLayerBelowTheReading) {
   const Eigen::Vector2d at = opticalAxisInNadirView(tilt, 443.0);
   EXPECT_NEAR(at.norm(), 443.0 * std::tan(tilt.roll), 1e-6);
   EXPECT_NEAR(opticalAxisInNadirView(CameraTilt{}, 443.0).norm(), 0.0, 1e-12);
+  // The frame's beam is that point when the frame was levelled, its centre when taken as level.
+  EXPECT_NEAR(beamInFrame(tilt, 443.0).x, at.x(), 1e-12);
+  EXPECT_NEAR(beamInFrame(tilt, 443.0).y, at.y(), 1e-12);
+  EXPECT_EQ(beamInFrame(std::nullopt, 443.0), cv::Point2d(0.0, 0.0));
 }
 
 TEST(CentreDepthRatio, NothingWhenItCannotBeTold) {

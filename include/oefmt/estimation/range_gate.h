@@ -17,6 +17,7 @@
 #include <optional>
 #include <vector>
 
+#include "oefmt/estimation/attitude.h"
 #include "oefmt/estimation/estimator.h"
 
 namespace oefmt {
@@ -85,6 +86,11 @@ class RangeAltitude {
 /// (opticalAxisInNadirView() for a levelled tilted frame; zero for a level camera).
 std::optional<double> centreDepthRatio(const cv::Mat1f& older, const cv::Mat1f& newer, const PairMotion& motion,
                                        cv::Point2d beam = {0.0, 0.0});
+
+/// Where the rangefinder's reading lies in a frame, relative to its centre [px] (the `beam` of
+/// centreDepthRatio()): the optical axis of a camera tilted by `tilt` in its levelled view of
+/// focal length `fx` (opticalAxisInNadirView()); the centre for a frame taken as level (no tilt).
+cv::Point2d beamInFrame(const std::optional<CameraTilt>& tilt, double fx);
 
 /// How many frames' readings vote which layer the rangefinder saw before the scale is taken from
 /// them (rangeScale): oefmt_offline runs them ahead, the node rescales after them.
