@@ -86,7 +86,9 @@ EnergyVectorOptions energyVectorOptions(const RegistrationConfig& config) {
 
 // Gauss-Newton steps of the zoom refinement (it starts within a bin: the first step lands close,
 // the second reweighs the pixels), and the pixels that take part: about 3 000 on a regular grid
-// pin four parameters and a photometric gain and bias far below a bin at any size.
+// pin four parameters and a photometric gain and bias far below a bin at any size. Not more
+// steps: over several depth layers they go on towards one similarity's compromise of all the
+// layers, away from the followed layer's zoom (doc/method.md).
 constexpr int kRefinementIterations = 2;
 constexpr double kRefinementPixels = 3000.0;
 // A refinement that moves the rotation or the zoom by more than this many bins of the log-polar
