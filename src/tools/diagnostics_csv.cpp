@@ -6,10 +6,14 @@
 namespace oefmt {
 namespace {
 
+// As long as the value needs: a diverged pose's %.6f can run to hundreds of digits, and a
+// truncated number would be silent garbage in the file.
 template <typename... Args>
 std::string format(const char* pattern, Args... args) {
-  char text[64];
-  std::snprintf(text, sizeof(text), pattern, args...);
+  const int length = std::snprintf(nullptr, 0, pattern, args...);
+  if (length <= 0) return std::string();
+  std::string text(static_cast<std::size_t>(length), '\0');
+  std::snprintf(text.data(), text.size() + 1, pattern, args...);
   return text;
 }
 

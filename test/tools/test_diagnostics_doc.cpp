@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
 #include <string>
 
@@ -41,6 +42,11 @@ TEST(DiagnosticsDoc, EveryLineHasOneValuePerColumn) {
   EXPECT_EQ(std::count(line.begin(), line.end(), ','), std::count(header.begin(), header.end(), ','));
   EXPECT_EQ(line.rfind("12,3.500000000,predicted,0,", 0), 0u) << line;
   EXPECT_NE(line.find(",-1.250000,"), std::string::npos) << line;
+  // A diverged pose is written in full, not cut at a buffer's end.
+  e.pose.y = 1e120;
+  char full[256];
+  std::snprintf(full, sizeof(full), ",%.6f,", e.pose.y);
+  EXPECT_NE(diagnosticsCsvLine(e).find(full), std::string::npos);
 }
 
 }  // namespace
