@@ -115,7 +115,7 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
                                                         context.window().taper(), kRefinementIterations, stride);
   const double rotation_bins = std::fabs(refined.similarity.rotation - start.rotation) * n / CV_PI;
   const double zoom_bins = std::fabs(refined.similarity.log_zoom - start.log_zoom) / log_zoom_per_bin;
-  if (!(refined.residual_end >= 0.0 && refined.residual_end <= refined.residual_start) ||
+  if (!(refined.loss_end >= 0.0 && refined.loss_end <= refined.loss_start) ||
       !(rotation_bins <= kRefinementMaxBins) ||
       !(zoom_bins <= kRefinementMaxBins)) {
     return;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include <opencv2/imgproc.hpp>
 
@@ -82,16 +83,47 @@ PixelResidual residualAt(const cv::Mat1f& older, const cv::Mat1f& newer, const I
   return p;
 }
 
-// 1.4826 x the median of `magnitudes` (absolute residuals; reordered): the Gaussian sigma of the
-// pixels that fit; negative when too few pixels took part.
-double medianSigma(std::vector<float>& magnitudes) {
+// The residuals' scale is read at the lower quartile of their magnitudes, not the median: over
+// several depth layers the followed one may hold as little as a quarter of the pixels (the others
+// move by pixels more), and a median then measures the other layers' misfit, under which the
+// biweight rejects nothing and the steps fit one similarity's compromise of all the layers. On
+// Gaussian residuals both read the same sigma.
+constexpr double kScaleQuantile = 0.25;
+// |r| of a Gaussian of sigma 1 has its lower quartile at sqrt(2) erf^-1(0.25).
+constexpr double kQuartileOfUnitGaussian = 0.318639;
+
+// The Gaussian sigma of the pixels that fit, from the absolute residuals `magnitudes` (reordered);
+// negative when too few pixels took part.
+double robustScale(std::vector<float>& magnitudes) {
   if (magnitudes.size() < kParameters * 10u) return -1.0;
+  auto quartile = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() * kScaleQuantile);
+  std::nth_element(magnitudes.begin(), quartile, magnitudes.end());
+  if (*quartile > 0.0f) return *quartile / kQuartileOfUnitGaussian;
+  // A quarter of the pixels fit exactly (flat texture in a noiseless frame): they tell no scale,
+  // the median does (1.4826: its factor for a Gaussian's magnitude).
   auto middle = magnitudes.begin() + magnitudes.size() / 2;
-  std::nth_element(magnitudes.begin(), middle, magnitudes.end());
+  std::nth_element(quartile, middle, magnitudes.end());
   return 1.4826 * *middle;
 }
 
-// Robust sigma (1.4826 x the median absolute residual) over every `stride`-th pixel inside both
+// The mean of Tukey's biweight loss (0 for a perfect fit, 1 beyond the threshold) over the
+// absolute residuals `magnitudes` at the scale `sigma`: what the steps lower. The pixels that fit
+// the best may do so whatever the motion (where the texture is flat, or near the centre for the
+// zoom), so a scale read at their quartile says little of the fit as a whole; the loss at one
+// scale counts every pixel.
+double tukeyLoss(const std::vector<float>& magnitudes, double sigma) {
+  if (magnitudes.empty()) return -1.0;
+  const double limit = kTukey * sigma;
+  double sum = 0.0;
+  for (float m : magnitudes) {
+    const double u = m / limit;
+    const double v = u * u < 1.0 ? 1.0 - u * u : 0.0;
+    sum += 1.0 - v * v * v;
+  }
+  return sum / magnitudes.size();
+}
+
+// Robust sigma (robustScale) over every `stride`-th pixel inside both
 // frames; negative when too few are.
 double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
                    const ImageSimilarity& motion, double gain, double bias, int stride,
@@ -108,7 +140,7 @@ double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::ve
     }
   }
   if (count != nullptr) *count = static_cast<int>(scratch.size());
-  return medianSigma(scratch);
+  return robustScale(scratch);
 }
 
 }  // namespace
@@ -139,6 +171,8 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   double sigma = robustSigma(older.smooth, newer.smooth, taper, start, gain, bias, sparse, scratch, nullptr);
   if (!(sigma > 0.0)) return out;
   out.residual_start = sigma;
+  const double sigma_start = sigma;
+  out.loss_start = tukeyLoss(scratch, sigma_start);
   for (int iteration = 0; iteration < iterations; ++iteration) {
     const InverseMap map(current, n);
     Normal normal = Normal::zeros();
@@ -175,7 +209,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       }
     }
     // The next step's scale: this pass's residuals (before its step).
-    const double next = medianSigma(scratch);
+    const double next = robustScale(scratch);
     if (!(next > 0.0)) return out;
     sigma = next;
     for (int a = 0; a < kParameters; ++a) {
@@ -194,6 +228,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   }
   out.residual_end = robustSigma(older.smooth, newer.smooth, taper, current, gain, bias, sparse, scratch, &out.pixels);
   out.similarity = current;
+  if (out.residual_end >= 0.0) out.loss_end = tukeyLoss(scratch, sigma_start);
   return out;
 }
 

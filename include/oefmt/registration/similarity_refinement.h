@@ -34,13 +34,17 @@ struct SimilarityRefinement {
   double residual_start = 0.0;  ///< robust sigma of the intensity residuals at the start
   double residual_end = 0.0;    ///< ... at the refined motion (negative: too few pixels)
   int pixels = 0;               ///< pixels of the sparse grid inside both frames at the end
+  /// Mean of Tukey's biweight loss (0..1) of the residuals at the start's robust sigma, at the
+  /// start and at the refined motion (negative: too few pixels): the fit improved when it fell.
+  double loss_start = -1.0;
+  double loss_end = -1.0;
 };
 
 /// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see, weighted by
 /// `taper` (the apodization, on both axes) and by Tukey's biweight at the residuals' robust sigma
-/// (measured before each step), so that a layer moving otherwise (parallax) or new content counts
-/// for little. Every `stride`-th pixel of every `stride`-th row takes part in the `iterations`
-/// steps.
+/// (measured before each step, at the residuals' lower quartile), so that a layer moving
+/// otherwise (parallax) or new content counts for little. Every `stride`-th pixel of every
+/// `stride`-th row takes part in the `iterations` steps.
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
                                       int iterations, int stride);
