@@ -12,6 +12,7 @@
 #include "oefmt/registration/registration.h"
 #include "oefmt/registration/similarity_refinement.h"
 #include "oefmt/registration/window.h"
+#include "oefmt/sim/similarity_views.h"
 #include "support/fixtures.h"
 #include "support/flight_fixtures.h"
 
@@ -96,6 +97,58 @@ TEST(ZoomRefinement, TheRefinementReadsSubBinRotationsToo) {
     EXPECT_NEAR(refined.similarity.rotation * kN / CV_PI, rotation_bins, 0.03) << rotation_bins;
     EXPECT_NEAR(refined.similarity.log_zoom / per_bin, 0.2, 0.03) << rotation_bins;
     EXPECT_LT(refined.residual_end, refined.residual_start) << rotation_bins;
+  }
+}
+
+// Two depth layers, each moved by its own similarity: the followed one (the start's shift) holds
+// `followed_share` of the pixels; the other is shifted 15 px further and zoomed 1.5 bins more
+// (roofs, a frame's step later).
+struct TwoLayerPair {
+  cv::Mat1f older, newer;
+  sim::ViewMotion followed, other;
+};
+
+TwoLayerPair twoLayerPair(double followed_share, double per_bin) {
+  const cv::Mat1f& ground = test::sceneTexture(8);
+  const cv::Mat1f& roofs = test::sceneTexture(9);
+  const cv::Point2d centre(ground.cols / 2.0, ground.rows / 2.0);
+  // Roof blocks over the ground, a fixed pattern on the texture that moves with the roofs.
+  const cv::Mat1f roof_mask = sim::blockMask(ground.size(), 5, 40.0, 1.0 - followed_share);
+  TwoLayerPair pair;
+  pair.followed = motionOf(0.4, 0.0, per_bin);
+  pair.other = motionOf(1.9, 0.0, per_bin);
+  pair.other.shift += cv::Point2d(15.0, 0.0);
+  auto view = [&](const sim::ViewMotion& ground_motion, const sim::ViewMotion& roof_motion) {
+    const cv::Mat1f g = sim::renderView(ground, centre, ground_motion, kN);
+    const cv::Mat1f r = sim::renderView(roofs, centre, roof_motion, kN);
+    const cv::Mat1f m = sim::renderView(roof_mask, centre, roof_motion, kN);
+    cv::Mat1f out(kN, kN);
+    for (int y = 0; y < kN; ++y) {
+      for (int x = 0; x < kN; ++x) out(y, x) = m(y, x) > 0.5f ? r(y, x) : g(y, x);
+    }
+    return out;
+  };
+  pair.older = view(sim::ViewMotion{}, sim::ViewMotion{});
+  pair.newer = view(pair.followed, pair.other);
+  return pair;
+}
+
+TEST(ZoomRefinement, FollowsItsLayerWhereTheOtherHoldsMostPixels) {
+  // The start is the followed layer's shift and a zoom read 0.3 bins short; the refinement reads
+  // that layer's zoom and is taken, also where the other layer holds most of the pixels.
+  const double per_bin = logZoomPerBin();
+  const SeparableWindow window(kN, RegistrationConfig{}.taper_fraction);
+  for (double share : {0.6, 0.4}) {
+    const TwoLayerPair pair = twoLayerPair(share, per_bin);
+    ImageSimilarity start;
+    start.translation = pair.followed.shift;
+    start.log_zoom = std::log(pair.followed.zoom) - 0.3 * per_bin;  // a spectral read, off by 0.3 bins
+    const SimilarityRefinement refined = refineSimilarity(
+        makeRefinementImage(pair.older), makeRefinementImage(pair.newer), start, window.taper(), 2,
+        static_cast<int>(std::lround(kN / std::sqrt(3000.0))));
+    EXPECT_NEAR(refined.similarity.log_zoom / per_bin, std::log(pair.followed.zoom) / per_bin, 0.05) << share;
+    EXPECT_LE(refined.loss_end, refined.loss_start) << share;
+    EXPECT_GE(refined.loss_end, 0.0) << share;
   }
 }
 
