@@ -44,8 +44,17 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   const auto alongMotion = [&](const cv::Point2d& d) {
     return across(d) <= prior.translation_radius && d.dot(predicted) >= 0.0;
   };
+  // The gate widens with the motion's spread (a vehicle that changed its speed may change it
+  // again), but the energy vectors' stretch (PMT) reads the followed layer's own length: where it
+  // does so within the gate, a peak further than tracking.layer_gate from that length is another
+  // layer or an alias, however wide the gate. Without this one switch between layers widens the
+  // spread of the last steps, and the wider gate lets the next switch through.
+  const double pmt_length = pmt.valid ? pmt.value * ref.shift : 0.0;
+  const bool pmt_reads_layer = pmt.valid && std::fabs(pmt_length - length) <= gate;
+  const double pmt_gate = std::max(config.tracking.layer_gate * pmt_length, kMinLayerGatePx);
   const auto followed = [&](const cv::Point2d& d) {
-    return alongMotion(d) && std::fabs(cv::norm(d) - length) <= gate;
+    return alongMotion(d) && std::fabs(cv::norm(d) - length) <= gate &&
+           (!pmt_reads_layer || std::fabs(cv::norm(d) - pmt_length) <= pmt_gate);
   };
   if (followed(measured.translation)) return;  // the correlation peak is the layer's
   if (registration.followed_confidence >= config.registration.min_confidence &&

@@ -61,8 +61,10 @@ struct Reference {
 /// - a weak prior that the pair continues pair 0-1's motion (tracking.motion_prior_sigma).
 ///
 /// With a predicted translation (`prior`, from the motion so far), the prediction decides which
-/// peak is the followed layer's instead of the PMT: the correlation peak when it lies within
-/// tracking.layer_gate of the prediction, else the peak the prediction points at
+/// peak is the followed layer's instead of the PMT: the correlation peak when it lies within the
+/// prediction's gate (tracking.layer_gate of it, or three sigmas of the motion's spread if wider)
+/// and, where the PMT reads the followed layer's length inside that gate, within
+/// tracking.layer_gate of the PMT's length; else the peak the prediction points at
 /// (PairRegistration::followed_translation) when it stands out; else the followed layer is not
 /// in view: the layers of steadyLayerStep (the followed layer's trace in the energy vector, or a
 /// layer seen in both pairs) give its length and the correlation peak its direction if that

@@ -124,6 +124,54 @@ TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
 
 // A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose
 // highest peak agreed with it: one reading is another layer's, and the spread says by how much.
+// The roofs' pair 1-2 of a flight whose last steps spread widely (one earlier hop between layers
+// left three sigmas of 24 px): the prediction of the followed roofs is 132 px, the ground's peak
+// (108.9 px, the highest) lies inside that gate, the roofs' own peak (a tenth of its height)
+// where they were predicted. The result of observe() for it, with the PMT's reading of the
+// followed layer given by `stretch` (0: no PMT).
+PairMotion observedWithStretch(double stretch, PairObservations* out = nullptr) {
+  RegistrationPrior prior;
+  prior.translation = {132.0, 0.0};
+  prior.translation_sigma = 8.0;
+  prior.translation_radius = 60.0;
+  detail::Reference ref;
+  ref.translation = {132.0, 0.0};
+  ref.shift = 132.0;
+  ref.shift_sigma = 0.5;
+  PairRegistration registration = withPeaks({{108.9, 1.0}, {132.0, 0.1}});
+  registration.translation = {108.9, 0.0};
+  MatchResult pmt;
+  pmt.valid = stretch > 0.0;
+  pmt.value = stretch;
+  pmt.sigma = 0.002;
+  PairMotion initial;
+  const PairObservations obs =
+      detail::observe(registration, motionAlongX(108.9), pmt, MatchResult(), ref, EstimatorConfig(),
+                      kShiftPerBin, 1.0, 1.0, &prior, initial);
+  if (out) *out = obs;
+  return initial;
+}
+
+// The PMT reads the roofs where they were predicted: the ground's peak is another layer, not a
+// 17 % speed drop in one frame, however wide the gate.
+TEST(ObserveFollowedLayer, ThePatternMatchKeepsTheLayerInsideAWideGate) {
+  PairObservations obs;
+  const PairMotion initial = observedWithStretch(1.0, &obs);
+  EXPECT_NEAR(initial.shift(), 132.0, 0.5);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
+  EXPECT_NEAR(initial.direction(), 0.0, 1e-9);
+}
+
+// Without the PMT the gate alone decides: a peak inside it is the followed layer's (the motion
+// changed). And where the PMT itself reads the shorter length, the speed did change.
+TEST(ObserveFollowedLayer, APeakThePatternMatchConfirmsStands) {
+  PairObservations obs;
+  EXPECT_NEAR(observedWithStretch(0.0, &obs).shift(), 108.9, 1e-9);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kVector);
+  EXPECT_NEAR(observedWithStretch(108.9 / 132.0, &obs).shift(), 108.9, 1e-9);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kVector);
+}
+
 TEST(LengthSpread, OtherReadingsInsideTheWindowWiden) {
   EXPECT_NEAR(detail::lengthSpread(108.9, {108.9, 131.8}, 0.05, 40.0), 22.9, 1e-9);
   // The largest of several; unbounded without a window.
