@@ -15,6 +15,7 @@
 #include "estimator_measurements.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/multi_zoom.h"
+#include "oefmt/estimation/plane_tilt_tracker.h"
 #include "worker_thread.h"
 
 namespace oefmt {
@@ -97,6 +98,8 @@ struct Estimator::State {
     last_step.reset();
     recent_steps.clear();
     recent_rates.clear();
+    plane_tilt.clear();
+    levelled = false;
     implausible_steps = 0;
     unconfirmed_steps = 0;
     started = false;
@@ -174,6 +177,10 @@ struct Estimator::State {
   // Pair 0-1 (the previous step): integrated motion, energy vectors, raw zoom.
   bool have01 = false;
   PairMotion motion01;
+  // The ground plane's tilt left in levelled views (the attitude source's error), from the
+  // refined pairs' stretch (oefmt mode, while frames come levelled).
+  PlaneTiltTracker plane_tilt;
+  bool levelled = false;  // the newest frame came levelled
   std::vector<float> translation01;  // T01 (efmt: the fused multi-zoom profile)
   std::vector<float> zoom01;         // S01
   double raw_log_zoom01 = 0.0;
@@ -328,6 +335,7 @@ cv::Matx44d Estimator::State::heldGrowth() const {
 }
 
 void Estimator::State::anchorFrame(WindowFrame&& frame, bool textured, Estimate& est) {
+  plane_tilt.clear();  // its readings are in the axes of frames the new anchor has no turn to
   if (!started) {
     integrator.reset(frame.stamp);
     started = true;
@@ -547,6 +555,9 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
 
 void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
                                std::vector<float>&& next_translation01, Estimate& est) {
+  const PairRegistration& measured = est.registration12;
+  plane_tilt.turn(measured.rotation);
+  if (levelled && measured.zoom_refined) plane_tilt.add(measured.stretch_a, measured.stretch_b, measured.translation);
   // Integrate, from the anchor if predictions were made while frames failed.
   if (anchor) integrator.restore(*anchor);
   // The pose takes the step with the spread of the lengths it could also have had (the PMT
@@ -621,6 +632,7 @@ void Estimator::reset() {
   state_->clear();
   frame_count_ = 0;
   turn_.reset();
+  levelled_ = false;
 }
 
 void Estimator::setTurn(double turn, double sigma) {
@@ -700,6 +712,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                         spectra.texture >= config_.registration.min_texture;
   WindowFrame frame{std::move(spectra), est.frame_index, stamp};
   const std::optional<std::pair<double, double>> turn = std::exchange(turn_, std::nullopt);  // this frame's only
+  const bool levelled = std::exchange(levelled_, false);
 
   if (!s.f1) {
     s.anchorFrame(std::move(frame), textured, est);
@@ -713,6 +726,16 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
                         s.shiftInReach(s.motion01.translation * (double(s.gap01 + est.frame_gap) / s.gap01));
     s.prior02 = with02 ? s.predictedPair(est.frame_gap, seconds12, &s.motion01) : std::nullopt;
+    // Levelled frames: the zooms are corrected for the tilt the attitude source left (zero until
+    // the readings tell it). A frame levelled or not unlike the one before starts the readings
+    // over: they describe another view.
+    if (levelled != s.levelled) s.plane_tilt.clear();
+    s.levelled = levelled;
+    const std::optional<cv::Point2d> plane_tilt =
+        levelled && config_.mode == EstimatorMode::kOefmt ? std::optional<cv::Point2d>(s.plane_tilt.tilt())
+                                                          : std::nullopt;
+    s.registrar.setPlaneTilt(plane_tilt);
+    s.registrar02.setPlaneTilt(plane_tilt);
     // A gyro's turn stands for the predicted rotation (the image turns against the camera).
     if (turn && s.prior02) {
       s.takeTurn(*s.prior02, s.motion01.rotation - turn->first,

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/registration/energy_vector.h"
+#include "oefmt/registration/plane_tilt.h"
 #include "oefmt/error.h"
 #include "oefmt/registration/phase_correlation.h"
 #include "oefmt/registration/similarity_refinement.h"
@@ -103,7 +104,8 @@ constexpr double kRefinementMaxBins = 2.0;
 // differs from the followed layer's by a fraction of a bin, and the heading carries every such
 // error into the direction of all later steps.
 void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const SpectralContext& context,
-                double log_zoom_per_bin, PairRegistration& result) {
+                double log_zoom_per_bin, const std::optional<cv::Point2d>& plane_tilt,
+                PairRegistration& result) {
   if (older.refinement.empty() || newer.refinement.empty()) return;
   const int n = context.size();
   ImageSimilarity start;
@@ -112,7 +114,8 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   start.translation = result.translation;
   const int stride = std::max(1, static_cast<int>(std::lround(n / std::sqrt(kRefinementPixels))));
   const SimilarityRefinement refined = refineSimilarity(older.refinement, newer.refinement, start,
-                                                        context.window().taper(), kRefinementIterations, stride);
+                                                        context.window().taper(), kRefinementIterations, stride,
+                                                        /*fit_stretch=*/plane_tilt.has_value());
   const double rotation_bins = std::fabs(refined.similarity.rotation - start.rotation) * n / CV_PI;
   const double zoom_bins = std::fabs(refined.similarity.log_zoom - start.log_zoom) / log_zoom_per_bin;
   if (!(refined.loss_end >= 0.0 && refined.loss_end <= refined.loss_start) ||
@@ -120,8 +123,11 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
       !(zoom_bins <= kRefinementMaxBins)) {
     return;
   }
-  result.zoom = std::exp(refined.similarity.log_zoom);
+  result.tilt_log_zoom = plane_tilt ? logZoomOfTilt(*plane_tilt, refined.similarity.translation) : 0.0;
+  result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
+  result.stretch_a = refined.similarity.stretch_a;
+  result.stretch_b = refined.similarity.stretch_b;
 }
 
 double confidenceFrom(double psr, double floor, double good) {
@@ -301,7 +307,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
   if (result.status == RegistrationStatus::kOk && context_->config().refine_zoom) {
-    refineZoom(older, newer, *context_, logZoomPerBin(), result);
+    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, result);
   }
 }
 

@@ -24,8 +24,9 @@ constexpr double kTukey = 4.685;
 constexpr double kAngleTolerance = 1e-5;
 constexpr double kShiftTolerance = 1e-3;
 
-// Parameters: rotation, log zoom, shift x, shift y, gain, bias.
-constexpr int kParameters = 6;
+// Parameters: rotation, log zoom, shift x, shift y, gain, bias, and optionally the stretch a, b.
+constexpr int kParameters = 8;
+constexpr int kSimilarityParameters = 6;
 using Normal = cv::Matx<double, kParameters, kParameters>;
 using Vector = cv::Vec<double, kParameters>;
 
@@ -57,9 +58,16 @@ struct InverseMap {
   InverseMap(const ImageSimilarity& m, int n) : c(n / 2) {
     const double s = std::exp(m.log_zoom);
     const double cs = std::cos(m.rotation), sn = std::sin(m.rotation);
-    // A(c + M^-1 (x - d - c)), M = s R(theta), R = [cos sin; -sin cos] (y down, counter-clockwise
-    // on screen).
-    i00 = cs / s, i01 = -sn / s, i10 = sn / s, i11 = cs / s;
+    // A(c + M^-1 (x - d - c)), M = (I + S) s R(theta), R = [cos sin; -sin cos] (y down,
+    // counter-clockwise on screen): M^-1 = R^T (I + S)^-1 / s.
+    const double r00 = cs / s, r01 = -sn / s, r10 = sn / s, r11 = cs / s;
+    const double a = m.stretch_a, b = m.stretch_b;
+    const double det = (1.0 + a) * (1.0 - a) - b * b;
+    const double s00 = (1.0 - a) / det, s01 = -b / det, s10 = -b / det, s11 = (1.0 + a) / det;
+    i00 = r00 * s00 + r01 * s10;
+    i01 = r00 * s01 + r01 * s11;
+    i10 = r10 * s00 + r11 * s10;
+    i11 = r10 * s01 + r11 * s11;
     tx = m.translation.x;
     ty = m.translation.y;
   }
@@ -95,7 +103,7 @@ constexpr double kQuartileOfUnitGaussian = 0.318639;
 // The Gaussian sigma of the pixels that fit, from the absolute residuals `magnitudes` (reordered);
 // negative when too few pixels took part.
 double robustScale(std::vector<float>& magnitudes) {
-  if (magnitudes.size() < kParameters * 10u) return -1.0;
+  if (magnitudes.size() < kSimilarityParameters * 10u) return -1.0;
   auto quartile = magnitudes.begin() + static_cast<std::ptrdiff_t>(magnitudes.size() * kScaleQuantile);
   std::nth_element(magnitudes.begin(), quartile, magnitudes.end());
   if (*quartile > 0.0f) return *quartile / kQuartileOfUnitGaussian;
@@ -154,7 +162,7 @@ RefinementImage makeRefinementImage(const cv::Mat1f& grey) {
 
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
-                                      int iterations, int stride) {
+                                      int iterations, int stride, bool fit_stretch) {
   const int n = newer.smooth.rows;
   if (older.empty() || newer.empty() || older.smooth.size() != newer.smooth.size() ||
       static_cast<int>(taper.size()) != n || newer.smooth.cols != n || stride < 1) {
@@ -173,6 +181,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   out.residual_start = sigma;
   const double sigma_start = sigma;
   out.loss_start = tukeyLoss(scratch, sigma_start);
+  const int parameters = fit_stretch ? kParameters : kSimilarityParameters;
   for (int iteration = 0; iteration < iterations; ++iteration) {
     const InverseMap map(current, n);
     Normal normal = Normal::zeros();
@@ -201,10 +210,12 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
         j[3] = -p.gy;
         j[4] = p.a;
         j[5] = 1.0;
-        for (int a = 0; a < kParameters; ++a) {
+        j[6] = -(p.gx * px - p.gy * py);  // stretch a: (px, -py)
+        j[7] = -(p.gx * py + p.gy * px);  // stretch b: (py, px)
+        for (int a = 0; a < parameters; ++a) {
           const double wj = w * j[a];
           rhs[a] += wj * p.r;
-          for (int b = a; b < kParameters; ++b) normal(a, b) += wj * j[b];
+          for (int b = a; b < parameters; ++b) normal(a, b) += wj * j[b];
         }
       }
     }
@@ -215,6 +226,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     for (int a = 0; a < kParameters; ++a) {
       for (int b = 0; b < a; ++b) normal(a, b) = normal(b, a);
     }
+    for (int a = parameters; a < kParameters; ++a) normal(a, a) = 1.0;  // rhs 0: no step
     Vector step;
     if (!cv::solve(normal, rhs, step, cv::DECOMP_CHOLESKY)) return out;
     current.rotation += step[0];
@@ -223,6 +235,8 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     current.translation.y += step[3];
     gain += step[4];
     bias += step[5];
+    current.stretch_a += step[6];
+    current.stretch_b += step[7];
     out.converged = std::fabs(step[0]) < kAngleTolerance && std::fabs(step[1]) < kAngleTolerance &&
                     std::fabs(step[2]) < kShiftTolerance && std::fabs(step[3]) < kShiftTolerance;
   }

@@ -481,6 +481,7 @@ void OdometryRos::process(const InputFrame& frame) {
       estimator_->setTurn(*turn, kGyroRateError * (frame.stamp.toSec() - previous_stamp_));
     }
   }
+  if (tilt && nadir_) estimator_->setLevelled();
   const auto start = std::chrono::steady_clock::now();
   const std::optional<Estimate> estimate = estimator_->push(image, frame.stamp.toSec());
   if (estimate) previous_stamp_ = frame.stamp.toSec();

@@ -402,6 +402,7 @@ int main(int argc, char** argv) {
           estimator->setTurn(*turn, oefmt::kGyroRateError * (frame.stamp - last_stamp));
         }
       }
+      if (frame.tilt) estimator->setLevelled();
       std::optional<oefmt::Estimate> estimate;
       try {
         estimate = estimator->push(std::move(frame.spectra), frame.stamp);

@@ -163,6 +163,15 @@ class Estimator {
   /// For the next push only.
   void setTurn(double turn, double sigma);
 
+  /// The next pushed frame was levelled by an attitude source (a virtual nadir view,
+  /// oefmt/io/nadir_view.h). In the oefmt mode the ground plane's tilt that the source's error
+  /// leaves in such views is then estimated from the pairs' stretch and taken out of their zooms
+  /// (oefmt/registration/plane_tilt.h): a levelled view off by an angle d [rad] reads a flight
+  /// of L metres at altitude h as a change of altitude by a fraction 1.5 d L / h (0.3 degrees
+  /// over 25 altitudes: 20 %). Frames not levelled are taken as a level camera's. For the next
+  /// push only.
+  void setLevelled() { levelled_ = true; }
+
   /// Copy pair 1-2's correlation surfaces into every Estimate (costs copies; for debug views).
   void setKeepSurfaces(bool keep) { keep_surfaces_ = keep; }
 
@@ -183,6 +192,7 @@ class Estimator {
   std::size_t frame_count_ = 0;
   bool keep_surfaces_ = false;
   std::optional<std::pair<double, double>> turn_;  // setTurn's, for the next push
+  bool levelled_ = false;                          // setLevelled's, for the next push
   std::unique_ptr<State> state_;
 };
 

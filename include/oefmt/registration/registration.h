@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -67,8 +68,14 @@ struct PairRegistration {
   double followed_confidence = 0.0;
   /// The rotation or zoom lay outside the prior's window: not confident, whatever the peaks.
   bool rotation_zoom_implausible = false;
-  /// The zoom was refined on the intensities (registration.refine_zoom).
+  /// The zoom was refined on the intensities (registration.refine_zoom), with the plane tilt
+  /// set (Registrar::setPlaneTilt) along with the area-preserving stretch [a b; b -a] of B's
+  /// content (oefmt/registration/plane_tilt.h; zero otherwise).
   bool zoom_refined = false;
+  double stretch_a = 0.0;
+  double stretch_b = 0.0;
+  /// ln(zoom) added for the ground plane's tilt (Registrar::setPlaneTilt), included in `zoom`.
+  double tilt_log_zoom = 0.0;
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
   bool warped = true;
@@ -150,6 +157,12 @@ class Registrar {
   /// Rotation/zoom peaks this Registrar tries (default: the configuration's
   /// rotation_zoom_candidates); clamped to >= 1.
   void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
+  /// Frames levelled by an attitude source: the ground plane's tilt left in the level view
+  /// [1/px, image axes] (the source's error), for which the refined zooms are corrected
+  /// (oefmt/registration/plane_tilt.h); the refinement then also fits each pair's stretch, the
+  /// reading of that tilt (PairRegistration::stretch_a, stretch_b). nullopt (the default): a
+  /// similarity is refined and nothing corrected.
+  void setPlaneTilt(const std::optional<cv::Point2d>& tilt) { plane_tilt_ = tilt; }
 
  private:
   // The rotation/zoom correlation surface of the pair, into rotation_zoom_surface_.
@@ -198,6 +211,7 @@ class Registrar {
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;
   int rotation_zoom_candidates_;
+  std::optional<cv::Point2d> plane_tilt_;
   double max_rotation_ = CV_PI;  // of the pair being registered (see registerPair)
 };
 

@@ -26,6 +26,11 @@ struct ImageSimilarity {
   double rotation = 0.0;
   double log_zoom = 0.0;
   cv::Point2d translation;
+  /// Area-preserving stretch S = [a b; b -a] applied after the rotation and zoom (B's content
+  /// x_B - c = (I + S) s R (x_A - c) + d); zero for a similarity. A plane that is not
+  /// perpendicular to the view stretches the images along the motion (see refineSimilarity).
+  double stretch_a = 0.0;
+  double stretch_b = 0.0;
 };
 
 struct SimilarityRefinement {
@@ -47,6 +52,6 @@ struct SimilarityRefinement {
 /// `stride`-th row takes part in the `iterations` steps.
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
-                                      int iterations, int stride);
+                                      int iterations, int stride, bool fit_stretch = false);
 
 }  // namespace oefmt

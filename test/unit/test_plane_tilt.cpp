@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A levelled view off by the attitude source's error sees the flat ground as a tilted plane: the
+// pair's zoom reads the flight as a climb or descent, and its stretch tells the tilt
+// (oefmt/registration/plane_tilt.h); PlaneTiltTracker follows that tilt over the pairs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/estimation/plane_tilt_tracker.h"
+#include "oefmt/registration/plane_tilt.h"
+#include "oefmt/registration/registration.h"
+#include "oefmt/sim/flight.h"
+#include "oefmt/sim/renderer.h"
+#include "support/fixtures.h"
+
+namespace oefmt {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// The stretch S = [a b; b -a] of the linear map I - d t^T (a plane of tilt t [1/px] seen by a
+// pair that moved by d [px]): the symmetric, trace-free part of -d t^T.
+std::pair<double, double> stretchOf(const cv::Point2d& tilt, const cv::Point2d& d) {
+  const double m00 = -d.x * tilt.x, m01 = -d.x * tilt.y, m10 = -d.y * tilt.x, m11 = -d.y * tilt.y;
+  return {(m00 - m11) / 2.0, (m01 + m10) / 2.0};
+}
+
+TEST(PlaneTilt, TheStretchOfATiltedPlaneGivesItsTilt) {
+  for (const cv::Point2d d : {cv::Point2d(80.0, 30.0), cv::Point2d(-12.0, 55.0), cv::Point2d(0.0, -40.0)}) {
+    for (const cv::Point2d tilt : {cv::Point2d(3e-5, -2e-5), cv::Point2d(-1e-4, 0.0), cv::Point2d(0.0, 5e-5)}) {
+      const auto [a, b] = stretchOf(tilt, d);
+      const cv::Point2d read = tiltFromStretch(a, b, d);
+      EXPECT_NEAR(read.x, tilt.x, 1e-12) << d << tilt;
+      EXPECT_NEAR(read.y, tilt.y, 1e-12) << d << tilt;
+      EXPECT_DOUBLE_EQ(logZoomOfTilt(tilt, d), 1.5 * tilt.dot(d));
+    }
+  }
+  EXPECT_EQ(tiltFromStretch(0.01, 0.02, cv::Point2d(0.0, 0.0)), cv::Point2d(0.0, 0.0));
+}
+
+// Two frames of a flight over flat ground whose camera is pitched and rolled by the same small
+// angle in both (a levelled view whose attitude was off by it): the pair's zoom reads a change of
+// altitude that is not there; the stretch the refinement fits reads the tilt, and the zoom
+// corrected for it is one.
+TEST(PlaneTilt, ALevelledViewOffByTheAttitudeErrorGetsItsZoomBack) {
+  constexpr int kN = 256;
+  sim::FlightOptions options;
+  options.width = options.height = kN;
+  options.flat = true;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.frames = 2;
+  options.track.length = 4.5;  // about 50 px at 20 m
+  options.track.altitude = 20.0;
+  options.seed = 4;
+  const sim::FlightPlan plan = sim::planFlight(options);
+  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
+  const sim::Renderer renderer(scene, plan.camera, 2);
+  RegistrationConfig config;
+  config.size = kN;
+  config.fft_planning = FftPlanning::kEstimate;
+  Registrar registrar(config);
+  for (const double error : {0.0, 2.0 * kDeg}) {
+    sim::FlightPose older = plan.poses[0], newer = plan.poses[1];
+    older.pitch = newer.pitch = error;
+    older.roll = newer.roll = -0.5 * error;
+    const FrameSpectra a = registrar.analyse(renderer.render(older).image);
+    const FrameSpectra b = registrar.analyse(renderer.render(newer).image);
+    registrar.setPlaneTilt(cv::Point2d(0.0, 0.0));
+    const PairRegistration plain = registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors);
+    ASSERT_TRUE(plain.zoom_refined) << error;
+    const cv::Point2d read = tiltFromStretch(plain.stretch_a, plain.stretch_b, plain.translation);
+    const double tilt = std::hypot(error, 0.5 * error) / plan.camera.intrinsics.fx;  // [1/px]
+    // The tilt read is the attitude error's, in size and direction (pitch 2, roll -1: along
+    // (2, -1) in the image, up to its sign), and the zoom misses 1.5 tilt.d (1.2 % here).
+    EXPECT_NEAR(cv::norm(read), tilt, 0.05 * tilt + 5e-6) << error;
+    EXPECT_NEAR(std::fabs(read.x + 2.0 * read.y), 0.0, 0.05 * tilt + 5e-6) << error;
+    EXPECT_NEAR(std::log(plain.zoom), -logZoomOfTilt(read, plain.translation), 0.0012) << error;
+    registrar.setPlaneTilt(read);
+    const PairRegistration corrected = registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors);
+    ASSERT_TRUE(corrected.zoom_refined) << error;
+    EXPECT_NEAR(std::log(corrected.zoom), 0.0, 0.0012) << error;
+    if (error > 0.0) {
+      EXPECT_GT(std::fabs(std::log(plain.zoom)), 0.004);
+    }
+    // Without a plane tilt set, a similarity is refined: no stretch.
+    registrar.setPlaneTilt(std::nullopt);
+    const PairRegistration similarity = registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors);
+    EXPECT_EQ(similarity.stretch_a, 0.0);
+    EXPECT_EQ(similarity.stretch_b, 0.0);
+    EXPECT_EQ(similarity.tilt_log_zoom, 0.0);
+  }
+}
+
+// A straight flight over flat ground whose levelled views are off by 1.5 degrees throughout (an
+// attitude source's error): taken as level the zooms read a climb or descent of a third of the
+// altitude over the 9 altitudes flown (1.5 x 1.5 deg x 9); told the frames were levelled
+// (Estimator::setLevelled),
+// the estimator reads the tilt from the pairs' stretch and keeps the altitude.
+TEST(PlaneTilt, TheEstimatorTakesTheTiltOutOfLevelledFrames) {
+  constexpr int kN = 256;
+  sim::FlightOptions options;
+  options.width = options.height = kN;
+  options.flat = true;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.frames = 40;
+  options.track.length = 39 * 4.5;
+  options.track.altitude = 20.0;
+  options.seed = 6;
+  sim::FlightPlan plan = sim::planFlight(options);
+  for (sim::FlightPose& pose : plan.poses) pose.pitch = 1.5 * kDeg;
+  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
+  const sim::Renderer renderer(scene, plan.camera, 2);
+  std::vector<cv::Mat1f> frames;
+  for (const sim::FlightPose& pose : plan.poses) frames.push_back(renderer.render(pose).image);
+  const auto altitudeChange = [&](bool levelled) {
+    EstimatorConfig config;
+    config.registration.size = kN;
+    config.registration.fft_planning = FftPlanning::kEstimate;
+    config.working_fx = plan.camera.intrinsics.fx;
+    Estimator estimator(config);
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      if (levelled) estimator.setLevelled();
+      const std::optional<Estimate> e = estimator.push(frames[k], 0.2 * static_cast<double>(k));
+      EXPECT_TRUE(e && (k == 0 || e->state == TrackingState::kTracking)) << k;
+    }
+    return estimator.pose().z;  // in units of the first altitude
+  };
+  const double as_level = altitudeChange(false);
+  const double levelled = altitudeChange(true);
+  EXPECT_GT(std::fabs(as_level), 0.2);
+  EXPECT_LT(std::fabs(levelled), 0.4 * std::fabs(as_level));
+}
+
+// Readings of one tilt from pairs moving in turning directions, with noise and a fifth of them
+// parallax outliers.
+TEST(PlaneTiltTracker, ReadsATiltThroughNoiseAndOutliers) {
+  const cv::Point2d truth(4e-5, -2.5e-5);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.2);
+  PlaneTiltTracker tracker;
+  for (int i = 0; i < 40; ++i) {
+    const double direction = 0.15 * i;
+    const cv::Point2d d(60.0 * std::cos(direction), 60.0 * std::sin(direction));
+    cv::Point2d tilt = truth + cv::Point2d(noise(rng), noise(rng)) * cv::norm(truth);
+    if (i % 5 == 2) tilt = -6.0 * truth;  // an outlier
+    const auto [a, b] = stretchOf(tilt, d);
+    tracker.add(a, b, d);
+    if (tracker.readings() < PlaneTiltTracker::kMinimumReadings) {
+      EXPECT_EQ(tracker.tilt(), cv::Point2d(0.0, 0.0));
+    }
+  }
+  EXPECT_EQ(tracker.readings(), PlaneTiltTracker::kReadings);
+  EXPECT_NEAR(tracker.tilt().x, truth.x, 0.15 * cv::norm(truth));
+  EXPECT_NEAR(tracker.tilt().y, truth.y, 0.15 * cv::norm(truth));
+}
+
+// A tilt that wanders steadily: the estimate is the newest tilt's (a median would be the window's
+// middle, 15 readings behind).
+TEST(PlaneTiltTracker, FollowsAWanderingTiltWithoutLag) {
+  PlaneTiltTracker tracker;
+  const cv::Point2d d(50.0, 20.0);
+  cv::Point2d tilt;
+  for (int i = 0; i < 50; ++i) {
+    tilt = cv::Point2d(1e-6 * i, -5e-7 * i);
+    const auto [a, b] = stretchOf(tilt, d);
+    tracker.add(a, b, d);
+  }
+  EXPECT_NEAR(tracker.tilt().x, tilt.x, 1e-9);
+  EXPECT_NEAR(tracker.tilt().y, tilt.y, 1e-9);
+}
+
+// The frames turn: the readings turn with them into the newest frame's axes.
+TEST(PlaneTiltTracker, ReadingsTurnWithTheFrames) {
+  PlaneTiltTracker tracker;
+  const cv::Point2d d(40.0, -30.0), tilt(3e-5, 1e-5);
+  for (std::size_t i = 0; i < PlaneTiltTracker::kMinimumReadings; ++i) {
+    const auto [a, b] = stretchOf(tilt, d);
+    tracker.add(a, b, d);
+  }
+  const double rotation = 0.4;
+  tracker.turn(rotation);
+  const cv::Point2d turned(std::cos(rotation) * tilt.x + std::sin(rotation) * tilt.y,
+                           -std::sin(rotation) * tilt.x + std::cos(rotation) * tilt.y);
+  EXPECT_NEAR(tracker.tilt().x, turned.x, 1e-12);
+  EXPECT_NEAR(tracker.tilt().y, turned.y, 1e-12);
+  tracker.clear();
+  EXPECT_EQ(tracker.tilt(), cv::Point2d(0.0, 0.0));
+}
+
+}  // namespace
+}  // namespace oefmt
