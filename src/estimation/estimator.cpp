@@ -736,6 +736,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                                                           : std::nullopt;
     s.registrar.setPlaneTilt(plane_tilt);
     s.registrar02.setPlaneTilt(plane_tilt);
+    if (plane_tilt) est.plane_tilt = *plane_tilt * config_.effectiveFx();
     // A gyro's turn stands for the predicted rotation (the image turns against the camera).
     if (turn && s.prior02) {
       s.takeTurn(*s.prior02, s.motion01.rotation - turn->first,

@@ -74,6 +74,13 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        "distance of the step's other length readings (PMT stretch, highest peak) from the integrated "
        "length, added to the pose's covariance along the step; 0 when they agree",
        [](const Estimate& e) { return format("%.4f", e.length_spread); }},
+      {"plane_tilt_x_rad", "rad",
+       "levelled frames: the ground plane's tilt left in the level view, its normal's component "
+       "along the image's x axis (the attitude's error as the pairs' stretch read it; the zooms "
+       "were corrected for it); 0 otherwise",
+       [](const Estimate& e) { return format("%.6f", e.plane_tilt.x); }},
+      {"plane_tilt_y_rad", "rad", "the same component along the image's y axis (down)",
+       [](const Estimate& e) { return format("%.6f", e.plane_tilt.y); }},
       {"optimizer_status", "", "the three-frame loop: converged, fallback (the measurements stand) or skipped",
        [](const Estimate& e) { return std::string(toString(e.loop.status)); }},
       {"optimizer_iterations", "", "Levenberg-Marquardt iterations over all starting points",

@@ -117,6 +117,7 @@ TEST(PlaneTilt, TheEstimatorTakesTheTiltOutOfLevelledFrames) {
   const sim::Renderer renderer(scene, plan.camera, 2);
   std::vector<cv::Mat1f> frames;
   for (const sim::FlightPose& pose : plan.poses) frames.push_back(renderer.render(pose).image);
+  cv::Point2d tilt_read;
   const auto altitudeChange = [&](bool levelled) {
     EstimatorConfig config;
     config.registration.size = kN;
@@ -127,13 +128,17 @@ TEST(PlaneTilt, TheEstimatorTakesTheTiltOutOfLevelledFrames) {
       if (levelled) estimator.setLevelled();
       const std::optional<Estimate> e = estimator.push(frames[k], 0.2 * static_cast<double>(k));
       EXPECT_TRUE(e && (k == 0 || e->state == TrackingState::kTracking)) << k;
+      if (e) tilt_read = e->plane_tilt;
     }
     return estimator.pose().z;  // in units of the first altitude
   };
   const double as_level = altitudeChange(false);
+  EXPECT_EQ(tilt_read, cv::Point2d(0.0, 0.0));  // not levelled: nothing estimated
   const double levelled = altitudeChange(true);
   EXPECT_GT(std::fabs(as_level), 0.2);
   EXPECT_LT(std::fabs(levelled), 0.4 * std::fabs(as_level));
+  // The estimate reports the tilt it corrected for: the 1.5 degrees of the attitude's error.
+  EXPECT_NEAR(cv::norm(tilt_read), 1.5 * kDeg, 0.3 * kDeg);
 }
 
 // Readings of one tilt from pairs moving in turning directions, with noise and a fifth of them

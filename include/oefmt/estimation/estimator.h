@@ -83,6 +83,11 @@ struct Estimate {
   /// noise within the acceleration window (detail::lengthSpread); added to the pose's covariance
   /// along the step. 0 when they agree.
   double length_spread = 0.0;
+  /// Levelled frames (setLevelled), oefmt mode: the tilt of the ground plane left in the level
+  /// view [rad, the frame's image axes: x right, y down], as the pairs' stretch read it, for
+  /// which this frame's refined zooms were corrected: the attitude source's error, seen from the
+  /// images. Zero otherwise, and until enough pairs were read.
+  cv::Point2d plane_tilt;
 
   double registration_ms = 0.0;  ///< spectra and registrations (efmt: with the multi-zoom profiles)
   double matching_ms = 0.0;      ///< pattern matching (part of estimator_ms)
