@@ -20,16 +20,15 @@ not change. --check exits with status 1 when a requirement of the default config
 """
 import argparse
 import csv
-import hashlib
-import json
 import math
 import os
 import resource
-import shutil
 import statistics
-import subprocess
 import sys
 import time
+
+import benchmark_common as common
+from benchmark_common import read_tum
 
 # Thresholds the shipped configuration must hold on every flight of the corpus.
 REQUIREMENTS = {
@@ -130,35 +129,13 @@ CORPUS = [
 CI_SUBSET = ["circle-parallax", "line-hill", "spin", "eight-natural-yaw", "circle-natural", "line-brick-flat"]
 
 
-def run(command, **kwargs):
-    result = subprocess.run(command, capture_output=True, text=True, **kwargs)
-    if result.returncode != 0:
-        sys.exit(f"generalization_benchmark: {' '.join(command)} failed "
-                 f"(exit status {result.returncode}):\n{result.stderr.strip()}")
-    return result
+def run(command):
+    return common.run(command, "generalization_benchmark")
 
 
 def render(tools, work, entry):
     """Renders the flight into work/<name> unless an identical render is there."""
-    folder = os.path.join(work, entry["name"])
-    key = hashlib.sha256(json.dumps(entry["options"]).encode()).hexdigest()
-    stamp = os.path.join(folder, ".options")
-    if os.path.exists(stamp) and open(stamp).read() == key:
-        return folder
-    shutil.rmtree(folder, ignore_errors=True)
-    run([os.path.join(tools, "oefmt_simulate"), "--quiet", *entry["options"], folder])
-    with open(stamp, "w") as out:
-        out.write(key)
-    return folder
-
-
-def read_tum(path):
-    rows = []
-    with open(path) as tum:
-        for line in tum:
-            if line.strip() and not line.startswith("#"):
-                rows.append([float(v) for v in line.split()])
-    return rows
+    return common.render(tools, os.path.join(work, entry["name"]), entry["options"], "generalization_benchmark")
 
 
 def yaw_of(row):
@@ -189,10 +166,7 @@ def estimate(tools, folder, mode, config, out_dir, altitude=None):
 
 
 def evaluate(tools, trajectory, truth, rigid):
-    command = [os.path.join(tools, "oefmt_evaluate"), "--json-only", "--match", "index", trajectory, truth]
-    if rigid:
-        command.append("--no-scale")
-    return json.loads(run(command).stdout.strip().splitlines()[-1])
+    return common.evaluate(tools, trajectory, truth, "generalization_benchmark", rigid=rigid, match="index")
 
 
 def frames_lost(diagnostics):

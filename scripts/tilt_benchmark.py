@@ -20,8 +20,8 @@ import argparse
 import json
 import math
 import os
-import subprocess
-import sys
+
+import benchmark_common as common
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TILT = ["--tilt", "--wobble", "8", "--wobble-hz", "1", "--imu", "--range"]
@@ -38,20 +38,11 @@ FLIGHTS = [
 
 
 def run(command):
-    result = subprocess.run(command, capture_output=True, text=True)
-    if result.returncode != 0:
-        sys.exit(f"tilt_benchmark: {' '.join(command)} failed:\n{result.stderr.strip()}")
-    return result.stdout
+    return common.run(command, "tilt_benchmark")
 
 
 def render(tools, folder, options):
-    stamp = os.path.join(folder, ".options")
-    key = json.dumps(options)
-    if os.path.exists(stamp) and open(stamp).read() == key:
-        return
-    run([os.path.join(tools, "oefmt_simulate"), "--quiet", *options, folder])
-    with open(stamp, "w") as out:
-        out.write(key)
+    common.render(tools, folder, options, "tilt_benchmark")
 
 
 def offline(tools, folder, output, *flags):
@@ -60,25 +51,16 @@ def offline(tools, folder, output, *flags):
 
 
 def evaluate(tools, trajectory, truth, rigid=False):
-    command = [os.path.join(tools, "oefmt_evaluate"), "--json-only", trajectory, truth]
-    if rigid:
-        command.append("--no-scale")
-    return json.loads(run(command).strip().splitlines()[-1])
+    return common.evaluate(tools, trajectory, truth, "tilt_benchmark", rigid=rigid)
 
 
-def read_tum(path):
-    poses = {}
-    with open(path) as lines:
-        for line in lines:
-            fields = line.split()
-            if fields and not fields[0].startswith("#"):
-                poses[round(float(fields[0]), 3)] = tuple(float(v) for v in fields[1:4])
-    return poses
+def positions_by_stamp(path):
+    return {round(row[0], 3): tuple(row[1:4]) for row in common.read_tum(path)}
 
 
 def path_length_error(trajectory, truth):
     """|L_estimate / L_truth - 1| of the 3-D paths over the frames both have (matched by stamp)."""
-    estimate, reference = read_tum(trajectory), read_tum(truth)
+    estimate, reference = positions_by_stamp(trajectory), positions_by_stamp(truth)
     stamps = sorted(set(estimate) & set(reference))
     def length(poses):
         return sum(math.dist(poses[a], poses[b]) for a, b in zip(stamps, stamps[1:]))
