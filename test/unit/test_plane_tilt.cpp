@@ -22,6 +22,7 @@ namespace oefmt {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+constexpr int kN = 256;
 
 // The stretch S = [a b; b -a] of the linear map I - d t^T (a plane of tilt t [1/px] seen by a
 // pair that moved by d [px]): the symmetric, trace-free part of -d t^T.
@@ -43,21 +44,25 @@ TEST(PlaneTilt, TheStretchOfATiltedPlaneGivesItsTilt) {
   EXPECT_EQ(tiltFromStretch(0.01, 0.02, cv::Point2d(0.0, 0.0)), cv::Point2d(0.0, 0.0));
 }
 
+// A straight flight of `frames` frames over flat ground at 20 m, 4.5 m (about 50 px) per frame.
+sim::FlightPlan flatLine(int frames, unsigned seed) {
+  sim::FlightOptions options;
+  options.width = options.height = kN;
+  options.flat = true;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.frames = frames;
+  options.track.length = (frames - 1) * 4.5;
+  options.track.altitude = 20.0;
+  options.seed = seed;
+  return sim::planFlight(options);
+}
+
 // Two frames of a flight over flat ground whose camera is pitched and rolled by the same small
 // angle in both (a levelled view whose attitude was off by it): the pair's zoom reads a change of
 // altitude that is not there; the stretch the refinement fits reads the tilt, and the zoom
 // corrected for it is one.
 TEST(PlaneTilt, ALevelledViewOffByTheAttitudeErrorGetsItsZoomBack) {
-  constexpr int kN = 256;
-  sim::FlightOptions options;
-  options.width = options.height = kN;
-  options.flat = true;
-  options.track.shape = sim::TrackShape::kLine;
-  options.track.frames = 2;
-  options.track.length = 4.5;  // about 50 px at 20 m
-  options.track.altitude = 20.0;
-  options.seed = 4;
-  const sim::FlightPlan plan = sim::planFlight(options);
+  const sim::FlightPlan plan = flatLine(2, 4);
   const auto scene = std::make_shared<const sim::Scene>(plan.scene);
   const sim::Renderer renderer(scene, plan.camera, 2);
   RegistrationConfig config;
@@ -99,19 +104,10 @@ TEST(PlaneTilt, ALevelledViewOffByTheAttitudeErrorGetsItsZoomBack) {
 // A straight flight over flat ground whose levelled views are off by 1.5 degrees throughout (an
 // attitude source's error): taken as level the zooms read a climb or descent of a third of the
 // altitude over the 9 altitudes flown (1.5 x 1.5 deg x 9); told the frames were levelled
-// (Estimator::setLevelled),
-// the estimator reads the tilt from the pairs' stretch and keeps the altitude.
+// (Estimator::setLevelled), the estimator reads the tilt from the pairs' stretch and keeps the
+// altitude.
 TEST(PlaneTilt, TheEstimatorTakesTheTiltOutOfLevelledFrames) {
-  constexpr int kN = 256;
-  sim::FlightOptions options;
-  options.width = options.height = kN;
-  options.flat = true;
-  options.track.shape = sim::TrackShape::kLine;
-  options.track.frames = 40;
-  options.track.length = 39 * 4.5;
-  options.track.altitude = 20.0;
-  options.seed = 6;
-  sim::FlightPlan plan = sim::planFlight(options);
+  sim::FlightPlan plan = flatLine(40, 6);
   for (sim::FlightPose& pose : plan.poses) pose.pitch = 1.5 * kDeg;
   const auto scene = std::make_shared<const sim::Scene>(plan.scene);
   const sim::Renderer renderer(scene, plan.camera, 2);
