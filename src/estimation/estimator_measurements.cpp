@@ -77,8 +77,8 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
                       length, config, shift_per_bin, intervals);
   // The energy vectors' stretch, where it differs from the peak's: the peak is another layer.
   const bool pmt_says_other_layer =
-      pmt.valid && std::fabs(measured.shift() - pmt.value * ref.shift) > gate &&
-      std::fabs(pmt.value * ref.shift - length) <= prior.translation_radius;
+      pmt.valid && std::fabs(measured.shift() - pmt_length) > gate &&
+      std::fabs(pmt_length - length) <= prior.translation_radius;
   if (layered.translation == measured.translation && !pmt_says_other_layer) {
     // No layer tells the followed one's length: a peak the vehicle can reach is the motion's
     // change (its layer is followed from here).
@@ -90,8 +90,8 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   if (layered.translation != measured.translation) {
     along = layered.shift();
     along_sigma = alongTrackSigma(layered);
-  } else if (pmt_says_other_layer || (pmt.valid && std::fabs(pmt.value * ref.shift - length) <= gate)) {
-    along = pmt.value * ref.shift;
+  } else if (pmt_says_other_layer || pmt_reads_layer) {
+    along = pmt_length;
     along_sigma = std::hypot(along * pmt.sigma, pmt.value * ref.shift_sigma);
   }
   along_sigma = std::max(along_sigma, kMinShiftSigma);
