@@ -193,5 +193,23 @@ TEST(PlaneTiltTracker, ReadingsTurnWithTheFrames) {
   EXPECT_EQ(tracker.tilt(), cv::Point2d(0.0, 0.0));
 }
 
+// Readings that say nothing are left out: no motion, a stretch or a turn that is not finite.
+TEST(PlaneTiltTracker, ReadingsThatSayNothingAreLeftOut) {
+  PlaneTiltTracker tracker;
+  const cv::Point2d d(40.0, -30.0), tilt(3e-5, 1e-5);
+  for (std::size_t i = 0; i < PlaneTiltTracker::kMinimumReadings; ++i) {
+    const auto [a, b] = stretchOf(tilt, d);
+    tracker.add(a, b, d);
+  }
+  tracker.add(0.01, 0.02, cv::Point2d(0.0, 0.0));
+  tracker.add(std::nan(""), 0.0, d);
+  tracker.add(0.0, INFINITY, d);
+  tracker.add(0.01, 0.0, cv::Point2d(std::nan(""), 1.0));
+  tracker.turn(std::nan(""));
+  EXPECT_EQ(tracker.readings(), PlaneTiltTracker::kMinimumReadings);
+  EXPECT_NEAR(tracker.tilt().x, tilt.x, 1e-12);
+  EXPECT_NEAR(tracker.tilt().y, tilt.y, 1e-12);
+}
+
 }  // namespace
 }  // namespace oefmt
