@@ -15,6 +15,7 @@ namespace {
 // Smoothing before the gradients [px]: a lens-sharp frame has gradients only a pixel wide, which
 // a warp off by a pixel at the image's edge no longer overlaps.
 constexpr double kSmoothingSigma = 1.0;
+constexpr int kSmoothingTaps = 5;
 
 // Tukey's biweight threshold in robust sigmas (95 % efficiency on Gaussian residuals): a pixel
 // of another depth layer, which moves by pixels more than the followed one, counts for nothing.
@@ -151,12 +152,61 @@ double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::ve
   return robustScale(scratch);
 }
 
+// Variance of the noise of the symmetric gradient (refineSimilarity's PixelResidual) when the
+// frames carry white noise of the given variances: both are smoothed by the refinement's
+// Gaussian (autocorrelation R), the newer frame's gradient is a central difference, the older's
+// the derivative of its bilinear interpolant (averaged over the sub-pixel position).
+double gradientNoiseVariance(double older_variance, double newer_variance) {
+  if (!(older_variance > 0.0) || !(newer_variance > 0.0)) return 0.0;
+  struct Factors {
+    double central = 0.0, bilinear = 0.0;  // per unit noise variance
+  };
+  static const Factors factors = [] {
+    const cv::Mat kernel = cv::getGaussianKernel(kSmoothingTaps, kSmoothingSigma, CV_64F);  // makeRefinementImage's
+    double r[3] = {0.0, 0.0, 0.0};  // the smoothing's 1-D autocorrelation at lags 0, 1, 2
+    for (int d = 0; d < 3; ++d) {
+      for (int i = 0; i + d < kernel.rows; ++i) r[d] += kernel.at<double>(i) * kernel.at<double>(i + d);
+    }
+    Factors f;
+    f.central = 0.5 * (r[0] - r[2]) * r[0];
+    f.bilinear = 2.0 * (r[0] - r[1]) * (2.0 * r[0] + r[1]) / 3.0;
+    return f;
+  }();
+  return 0.25 * (older_variance * factors.bilinear + newer_variance * factors.central);
+}
+
+// The exposure's offset between the frames at `motion`: the mean difference of the pixels both
+// see (every `stride`-th of every `stride`-th row; their differences are left in `residuals`);
+// 0 when too few do. Left to the steps instead, an exposure change larger than the texture's
+// contrast sets the first step's robust scale, under which the biweight keeps every depth layer
+// and the steps fit their compromise. The mean, not the median: a levelled view fills what the
+// camera did not see with the mean of what it saw, which leaves the mean and not the median.
+double exposureOffset(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+                      const ImageSimilarity& motion, int stride, std::vector<float>& residuals) {
+  const int n = newer.rows;
+  const InverseMap map(motion, n);
+  residuals.clear();
+  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
+    if (!(taper[y] > 0.0f)) continue;
+    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
+      if (!(taper[x] > 0.0f)) continue;
+      const PixelResidual p = residualAt(older, newer, map, 1.0, 0.0, x, y);
+      if (p.inside) residuals.push_back(static_cast<float>(p.r));
+    }
+  }
+  if (residuals.size() < kSimilarityParameters * 10u) return 0.0;
+  double sum = 0.0;
+  for (const float difference : residuals) sum += difference;
+  return sum / static_cast<double>(residuals.size());
+}
+
 }  // namespace
 
-RefinementImage makeRefinementImage(const cv::Mat1f& grey) {
+RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance) {
   RefinementImage image;
   if (grey.empty()) return image;
-  cv::GaussianBlur(grey, image.smooth, cv::Size(5, 5), kSmoothingSigma, kSmoothingSigma, cv::BORDER_REFLECT);
+  image.noise_variance = std::isfinite(noise_variance) && noise_variance > 0.0 ? noise_variance : 0.0;
+  cv::GaussianBlur(grey, image.smooth, cv::Size(kSmoothingTaps, kSmoothingTaps), kSmoothingSigma, kSmoothingSigma, cv::BORDER_REFLECT);
   return image;
 }
 
@@ -171,8 +221,11 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   SimilarityRefinement out;
   out.similarity = start;
   ImageSimilarity current = start;
-  double gain = 1.0, bias = 0.0;
+  double gain = 1.0;
   std::vector<float> scratch;
+  // The exposure's offset on the steps' grid: on the sparser one its estimate is noisy enough to
+  // move the first step's robust weights on frames without any.
+  double bias = exposureOffset(older.smooth, newer.smooth, taper, start, stride, scratch);
   // The residuals' scale before and after, on a sparser grid (the start's only sets the first
   // step's robust weights).
   const int sparse = 2 * stride;
@@ -182,6 +235,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   const double sigma_start = sigma;
   out.loss_start = tukeyLoss(scratch, sigma_start);
   const int parameters = fit_stretch ? kParameters : kSimilarityParameters;
+  const double gradient_noise = gradientNoiseVariance(older.noise_variance, newer.noise_variance);
   for (int iteration = 0; iteration < iterations; ++iteration) {
     const InverseMap map(current, n);
     Normal normal = Normal::zeros();
@@ -216,6 +270,16 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
           const double wj = w * j[a];
           rhs[a] += wj * p.r;
           for (int b = a; b < parameters; ++b) normal(a, b) += wj * j[b];
+        }
+        if (gradient_noise > 0.0) {
+          // The gradients' noise adds var (U U^T + V V^T) to the expected normal matrix, with
+          // j_geometric = -(g_x U + g_y V); without its removal every step falls short.
+          const double u[kParameters] = {py, px, 1.0, 0.0, 0.0, 0.0, px, py};
+          const double v[kParameters] = {-px, py, 0.0, 1.0, 0.0, 0.0, -py, px};
+          const double wn = w * gradient_noise;
+          for (int a = 0; a < parameters; ++a) {
+            for (int b = a; b < parameters; ++b) normal(a, b) -= wn * (u[a] * u[b] + v[a] * v[b]);
+          }
         }
       }
     }

@@ -212,7 +212,15 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   context_->window().apply(frame.grey, windowed, frame.mean);
   fft.forwardInPlace(frame.spectrum);
   if (context_->config().noise_weighting) frame.noise_power = noisePower(frame.spectrum);
-  if (context_->config().refine_zoom) frame.refinement = makeRefinementImage(frame.grey);
+  if (context_->config().refine_zoom) {
+    // White noise of variance v has |.|^2 = v sum(w^2) at every frequency of the apodized image's
+    // spectrum (w the separable window).
+    double taper_energy = 0.0;
+    for (const float t : context_->window().taper()) taper_energy += static_cast<double>(t) * t;
+    const double noise_variance =
+        taper_energy > 0.0 ? frame.noise_power / (taper_energy * taper_energy) : 0.0;
+    frame.refinement = makeRefinementImage(frame.grey, noise_variance);
+  }
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   cv::Mat1f log_polar = fft.inPlaceInput(frame.log_polar_spectrum);
   context_->logPolar(magnitude_, log_polar);

@@ -268,6 +268,22 @@ TEST(Spectra, NoisePowerOfWhiteNoiseIsItsMeanPowerPerFrequency) {
   EXPECT_LT(noisePower(spectrum), 1e-3 * n * n * 0.02 * 0.02);
 }
 
+TEST(Spectra, TheRefinementImageKnowsTheFramesSensorNoise) {
+  // A textured frame under white noise of std s: the refinement image carries s^2 (from the
+  // spectrum's noise power over the apodization's energy), which its steps take out of the
+  // gradients (refineSimilarity). The test texture's own fine detail reads as about 0.02^2 more.
+  const auto context = test::sharedContext(256);
+  SpectraBuilder builder(context);
+  const auto pair = test::warpedPair(sim::ViewMotion{}, 256, 5);
+  for (const double sigma : {0.05, 0.1}) {
+    cv::Mat1f noisy = pair.older.clone(), noise(noisy.size());
+    cv::RNG(17).fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+    noisy += noise;
+    const FrameSpectra frame = builder.build(noisy);
+    EXPECT_NEAR(frame.refinement.noise_variance / (sigma * sigma), 1.0, 0.25) << sigma;
+  }
+}
+
 TEST(Spectra, AFramesSpectraDoNotDependOnTheBuildersHistory) {
   const auto first = test::warpedPair(sim::ViewMotion{}, 128, 5);
   const auto second = test::warpedPair(sim::ViewMotion{}, 128, 9);

@@ -12,12 +12,14 @@ namespace oefmt {
 /// A frame's image as the refinement reads it.
 struct RefinementImage {
   cv::Mat1f smooth;  ///< the grey image, Gaussian-smoothed
+  /// Variance of the grey image's white sensor noise, before the smoothing (0: none known).
+  double noise_variance = 0.0;
 
   bool empty() const { return smooth.empty(); }
 };
 
-/// Smooths `grey`.
-RefinementImage makeRefinementImage(const cv::Mat1f& grey);
+/// Smooths `grey`, whose white sensor noise has the variance `noise_variance` (0: unknown).
+RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance = 0.0);
 
 /// A similarity in the registration's convention (PairRegistration): the newer frame B shows the
 /// older A turned by `rotation` (counter-clockwise on screen) and scaled by exp(log_zoom) about
@@ -49,7 +51,10 @@ struct SimilarityRefinement {
 /// `taper` (the apodization, on both axes) and by Tukey's biweight at the residuals' robust sigma
 /// (measured before each step, at the residuals' lower quartile), so that a layer moving
 /// otherwise (parallax) or new content counts for little. Every `stride`-th pixel of every
-/// `stride`-th row takes part in the `iterations` steps.
+/// `stride`-th row takes part in the `iterations` steps. The bias starts at the frames' mean
+/// difference over those pixels (an exposure change), and where the frames' noise variances are
+/// known the gradients' noise is taken out of the normal equations, which it would otherwise
+/// inflate, shortening every step.
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
                                       int iterations, int stride, bool fit_stretch = false);
