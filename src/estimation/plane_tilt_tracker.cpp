@@ -12,8 +12,10 @@ namespace {
 
 // Gaussian sigma per median absolute deviation.
 constexpr double kMadToSigma = 1.4826;
-// Readings further than this many robust sigmas from the median are outliers (parallax).
-constexpr double kOutlierSigmas = 3.0;
+// Tukey's biweight threshold in robust sigmas (95 % efficiency on Gaussian readings): readings
+// far from the median (parallax) count for nothing, and a reading's weight falls smoothly on the
+// way there, so that a tiny change of one reading never flips the line.
+constexpr double kTukey = 4.685;
 
 double median(std::vector<double> values) {
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -21,25 +23,27 @@ double median(std::vector<double> values) {
   return *middle;
 }
 
-// The value at the last index of a least-squares line through `values` (index = arrival order),
-// leaving out the outliers.
+// The value at the last index of a weighted least-squares line through `values` (index = arrival
+// order), each reading weighted by Tukey's biweight of its distance from their median.
 double lineEnd(const std::vector<double>& values) {
   const double centre = median(values);
   std::vector<double> deviations;
   deviations.reserve(values.size());
   for (double v : values) deviations.push_back(std::fabs(v - centre));
-  const double limit = kOutlierSigmas * kMadToSigma * median(deviations);
+  const double limit = kTukey * kMadToSigma * median(deviations);
   // Index t counted back from the newest (t = 0), so the line's intercept is its end.
   double n = 0.0, st = 0.0, sv = 0.0, stt = 0.0, stv = 0.0;
   const double newest = static_cast<double>(values.size() - 1);
   for (std::size_t i = 0; i < values.size(); ++i) {
-    if (std::fabs(values[i] - centre) > limit) continue;
+    const double u = limit > 0.0 ? (values[i] - centre) / limit : 0.0;
+    if (!(u * u < 1.0)) continue;
+    const double w = (1.0 - u * u) * (1.0 - u * u);
     const double t = static_cast<double>(i) - newest;
-    n += 1.0;
-    st += t;
-    sv += values[i];
-    stt += t * t;
-    stv += t * values[i];
+    n += w;
+    st += w * t;
+    sv += w * values[i];
+    stt += w * t * t;
+    stv += w * t * values[i];
   }
   const double det = n * stt - st * st;
   if (!(det > 0.0)) return centre;

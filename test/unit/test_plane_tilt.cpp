@@ -211,5 +211,24 @@ TEST(PlaneTiltTracker, ReadingsThatSayNothingAreLeftOut) {
   EXPECT_NEAR(tracker.tilt().y, tilt.y, 1e-12);
 }
 
+TEST(PlaneTiltTracker, ASmallChangeOfOneReadingMovesTheTiltALittle) {
+  // A bag and a folder of the same flight round their attitudes differently: the tilt must not
+  // flip where one reading crosses the outlier's threshold. The newest reading (the line's end
+  // leans on it the most) sits where a cut at three robust sigmas would drop it; moved by 1e-9
+  // either way, the tilt moves by as little.
+  const auto tiltWithNewest = [](double newest) {
+    PlaneTiltTracker tracker;
+    // add(a, b, (1, 0)) reads the tilt (-2a, -2b) (tiltFromStretch).
+    for (int k = 0; k < 29; ++k) tracker.add(-0.5 * (1e-4 * ((k * 7) % 11 - 5)), 0.0, {1.0, 0.0});
+    tracker.add(-0.5 * newest, 0.0, {1.0, 0.0});
+    return tracker.tilt().x;
+  };
+  // The 30 readings: median 1e-4, median absolute deviation 3e-4 (the newest one's 3 sigmas out).
+  const double three_sigmas = 1e-4 + 3.0 * 1.4826 * 3e-4;
+  const double below = tiltWithNewest(three_sigmas - 1e-9), above = tiltWithNewest(three_sigmas + 1e-9);
+  EXPECT_LT(std::fabs(above - below), 1e-7);
+  EXPECT_NE(below, 0.0);
+}
+
 }  // namespace
 }  // namespace oefmt

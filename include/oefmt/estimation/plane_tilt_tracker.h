@@ -26,10 +26,12 @@ class PlaneTiltTracker {
   std::size_t readings() const { return readings_.size(); }
 
   /// The tilt [1/px, the newest frame's image axes] at the newest reading: per axis a straight
-  /// line fitted to the readings in the order they came, after dropping those further than three
-  /// robust sigmas from their median. A median of the window would lag half of it behind a tilt
-  /// that wanders (on the tilting flights of the benchmarks the estimate then correlated best
-  /// with the truth of 15 frames before); the line's end does not. Zero before kMinimumReadings.
+  /// line fitted to the readings in the order they came, each weighted by Tukey's biweight of its
+  /// distance from their median (4.685 robust sigmas: the weights fall smoothly, so that a tiny
+  /// change of one reading moves the line a little and never flips it). A median of the window
+  /// would lag half of it behind a tilt that wanders (on the tilting flights of the benchmarks
+  /// the estimate then correlated best with the truth of 15 frames before); the line's end does
+  /// not. Zero before kMinimumReadings.
   cv::Point2d tilt() const;
 
  private:
