@@ -53,19 +53,6 @@ bool bilinear(const cv::Mat1f& image, double x, double y, double& value, double&
   return true;
 }
 
-// bilinear()'s value alone.
-bool bilinearValue(const cv::Mat1f& image, double x, double y, double& value) {
-  if (!(x >= 1.0 && y >= 1.0 && x < image.cols - 2.0 && y < image.rows - 2.0)) return false;
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const double tx = x - x0, ty = y - y0;
-  const float* r0 = image[y0];
-  const float* r1 = image[y0 + 1];
-  const double a00 = r0[x0], a01 = r0[x0 + 1], a10 = r1[x0], a11 = r1[x0 + 1];
-  const double top = a00 + tx * (a01 - a00), bottom = a10 + tx * (a11 - a10);
-  value = top + ty * (bottom - top);
-  return true;
-}
-
 // The motion as the inverse map of the newer frame's pixels into the older one's.
 struct InverseMap {
   double c, tx, ty, i00, i01, i10, i11;
@@ -203,10 +190,10 @@ double exposureOffset(const cv::Mat1f& older, const cv::Mat1f& newer, const std:
     if (!(taper[y] > 0.0f)) continue;
     for (int x = stride / 2 + 1; x < n - 1; x += stride) {
       if (!(taper[x] > 0.0f)) continue;
-      // residualAt's difference at gain 1 and bias 0, without its gradients.
+      // residualAt's difference at gain 1 and bias 0, without its symmetric gradient.
       const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
-      double a = 0.0;
-      if (bilinearValue(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a)) {
+      double a = 0.0, ax = 0.0, ay = 0.0;
+      if (bilinear(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a, ax, ay)) {
         residuals.push_back(static_cast<float>(newer(y, x) - a));
       }
     }

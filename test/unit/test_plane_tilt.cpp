@@ -175,14 +175,20 @@ TEST(PlaneTiltTracker, FollowsAWanderingTiltWithoutLag) {
   EXPECT_NEAR(tracker.tilt().y, tilt.y, 1e-9);
 }
 
-// The frames turn: the readings turn with them into the newest frame's axes.
-TEST(PlaneTiltTracker, ReadingsTurnWithTheFrames) {
+// A tracker holding just enough readings of one tilt, from pairs moving by d.
+PlaneTiltTracker trackerReading(const cv::Point2d& tilt, const cv::Point2d& d) {
   PlaneTiltTracker tracker;
-  const cv::Point2d d(40.0, -30.0), tilt(3e-5, 1e-5);
   for (std::size_t i = 0; i < PlaneTiltTracker::kMinimumReadings; ++i) {
     const auto [a, b] = stretchOf(tilt, d);
     tracker.add(a, b, d);
   }
+  return tracker;
+}
+
+// The frames turn: the readings turn with them into the newest frame's axes.
+TEST(PlaneTiltTracker, ReadingsTurnWithTheFrames) {
+  const cv::Point2d d(40.0, -30.0), tilt(3e-5, 1e-5);
+  PlaneTiltTracker tracker = trackerReading(tilt, d);
   const double rotation = 0.4;
   tracker.turn(rotation);
   const cv::Point2d turned(std::cos(rotation) * tilt.x + std::sin(rotation) * tilt.y,
@@ -195,12 +201,8 @@ TEST(PlaneTiltTracker, ReadingsTurnWithTheFrames) {
 
 // Readings that say nothing are left out: no motion, a stretch or a turn that is not finite.
 TEST(PlaneTiltTracker, ReadingsThatSayNothingAreLeftOut) {
-  PlaneTiltTracker tracker;
   const cv::Point2d d(40.0, -30.0), tilt(3e-5, 1e-5);
-  for (std::size_t i = 0; i < PlaneTiltTracker::kMinimumReadings; ++i) {
-    const auto [a, b] = stretchOf(tilt, d);
-    tracker.add(a, b, d);
-  }
+  PlaneTiltTracker tracker = trackerReading(tilt, d);
   tracker.add(0.01, 0.02, cv::Point2d(0.0, 0.0));
   tracker.add(std::nan(""), 0.0, d);
   tracker.add(0.0, INFINITY, d);
