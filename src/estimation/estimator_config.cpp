@@ -191,6 +191,10 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
                       "translation error along the motion per shift peak width"),
       numberParameter("uncertainty.direction_scale", u.direction_scale, "", closedRange(1e-4, 100.0),
                       "translation error across the motion per (shift times direction peak width)"),
+      numberParameter("uncertainty.refined_rotation_scale", u.refined_rotation_scale, "",
+                      closedRange(1e-4, 100.0),
+                      "rotation error per sigma of the zoom refinement's rotation (from its normal "
+                      "equations); the pair's rotation weighs it against the surface's"),
 
       integerParameter("efmt.zoom_samples", e.zoom_samples, "", closedRange(1, 50),
                        "zoom hypotheses sampled between the least and the most significant zoom"),

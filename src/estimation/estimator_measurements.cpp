@@ -119,6 +119,16 @@ PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
                               kMinRotationSigma);
   m.log_zoom_sigma = std::max(finiteOr(r.log_zoom_sigma, 1.0) * (predicted ? 1.0 : u.log_zoom_scale),
                               kMinLogZoomSigma);
+  if (!predicted && r.zoom_refined && r.refined_rotation_sigma > 0.0 && std::isfinite(r.refined_rotation)) {
+    // Two readings of the rotation: the surface's peak, whose fraction of a bin leans towards
+    // or away from the whole bin by a few hundredths of a bin (every frame alike in a steady
+    // turn, so the heading drifts), and the refinement's, unbiased on one plane but noisy on weak
+    // texture and pulled by other depth layers. Each weighs by its error sigma.
+    const double surface = m.rotation_sigma;
+    const double refined = std::max(r.refined_rotation_sigma * u.refined_rotation_scale, kMinRotationSigma);
+    const double weight = surface * surface / (surface * surface + refined * refined);
+    m.rotation = wrapToPi(m.rotation + weight * wrapToPi(r.refined_rotation - r.rotation));
+  }
   const double shift = m.shift();
   const double along = std::max(finiteOr(r.shift_sigma, 1e3) * u.shift_scale, kMinShiftSigma);
   // Below a pixel the direction means little: the along-track sigma holds in every direction.

@@ -99,10 +99,10 @@ constexpr double kRefinementMaxBins = 2.0;
 // The log-polar surface reads a sub-bin zoom (and rotation) towards the nearest bin: at most
 // radii its samples are as coarse as the grain of the magnitude spectrum, so a fraction of a bin
 // does not move them as a whole. The intensities of both frames tell the rest (doc/method.md).
-// The rotation is refined along with the zoom, which it would otherwise bias, but not taken:
-// where the scene holds several depths or inclined planes, the rotation that fits the most pixels
-// differs from the followed layer's by a fraction of a bin, and the heading carries every such
-// error into the direction of all later steps.
+// The rotation is refined along with the zoom, which it would otherwise bias, but not taken as
+// it is: where the scene holds several depths or inclined planes, the rotation that fits the most
+// pixels differs from the followed layer's by a fraction of a bin. It is reported with its sigma
+// beside the surface's, and the estimator weighs the two (doc/method.md).
 void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const SpectralContext& context,
                 double log_zoom_per_bin, const std::optional<cv::Point2d>& plane_tilt,
                 PairRegistration& result) {
@@ -126,6 +126,12 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   result.tilt_log_zoom = plane_tilt ? logZoomOfTilt(*plane_tilt, refined.similarity.translation) : 0.0;
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
+  if (!plane_tilt) {
+    // A levelled view keeps its attitude source's error as a perspective that the similarity
+    // and stretch do not model, and the refined rotation takes up part of it.
+    result.refined_rotation = refined.similarity.rotation;
+    result.refined_rotation_sigma = refined.rotation_sigma;
+  }
   result.stretch_a = refined.similarity.stretch_a;
   result.stretch_b = refined.similarity.stretch_b;
 }

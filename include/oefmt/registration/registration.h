@@ -72,6 +72,11 @@ struct PairRegistration {
   /// set (Registrar::setPlaneTilt) along with the area-preserving stretch [a b; b -a] of B's
   /// content (oefmt/registration/plane_tilt.h; zero otherwise).
   bool zoom_refined = false;
+  /// The refinement's own reading of the rotation [rad] and its sigma from the refinement's
+  /// normal equations (SimilarityRefinement::rotation_sigma; 0: none). `rotation` stays the
+  /// surface's: the estimator weighs the two (doc/method.md).
+  double refined_rotation = 0.0;
+  double refined_rotation_sigma = 0.0;
   double stretch_a = 0.0;
   double stretch_b = 0.0;
   /// ln(zoom) added for the ground plane's tilt (Registrar::setPlaneTilt), included in `zoom`.
