@@ -467,8 +467,6 @@ TEST(Tools, OfflineRefusesTinyFrames) {
   EXPECT_NE(tiny.err.find("0001.png: image of 40x30"), std::string::npos) << tiny.err;
 }
 
-// scripts/measure_speed.py: a line with the figures of each run, the summaries, and a clear
-// error when there is no oefmt_offline to run.
 // A tilting multirotor's flight (IMU and rangefinder written): levelled by the IMU, the frames
 // register as a level camera's, and the rangefinder makes the trajectory metric, from a folder
 // and from a bag alike; without them the tilt is read as motion.
@@ -568,6 +566,8 @@ TEST(Tools, OfflineTakesTheCameraMountInTheImusFrameFromTheBagsTf) {
   EXPECT_GT(largestDifference(poses(dir / "aligned.tum"), poses(dir / "untold.tum")), 0.05);
 }
 
+// scripts/measure_speed.py: a line with the figures of each run, the summaries, and a clear
+// error when there is no oefmt_offline to run.
 TEST(Tools, MeasureSpeedReportsEveryRun) {
   TempDir dir;
   ASSERT_NO_FATAL_FAILURE(simulateThreeFrames(dir));

@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Calibrates uncertainty.refined_rotation_scale: renders flights that are not in the
+generalization corpus (other seeds and scenes), runs oefmt_offline on each and compares both
+readings of every registered pair's rotation with the truth.
+
+The pair's rotation is the inverse-variance mean of the rotation surface's reading (sigma: its
+peak width times uncertainty.rotation_scale) and the zoom refinement's (sigma: its normal
+equations' times uncertainty.refined_rotation_scale), see doc/method.md. Only their ratio sets
+the weights, so the scale that puts both on the same footing is the one under which the same
+share of errors (90 %) lies within the sigma for both:
+
+  refined_rotation_scale = q90(|refined error| / refined sigma) / q90(|surface error| / surface sigma)
+
+  scripts/calibrate_rotation_sigma.py [--tools build/devel/lib/oefmt] [--work build/calibration]
+"""
+import argparse
+import csv
+import math
+import os
+import subprocess
+import sys
+
+# Level circles with a fixed heading (the true rotation of every pair is zero), 80 frames each,
+# scenes unlike one another: the default one, natural texture, walls, weak texture, low overlap,
+# brick.
+FLIGHTS = [
+    ("default", ["--seed", "41"]),
+    ("natural", ["--seed", "42", "--texture-style", "natural"]),
+    ("walls", ["--seed", "43", "--levels", "3,6", "--walls", "--altitude", "20"]),
+    ("weak", ["--seed", "44", "--contrast", "12", "--noise-grey", "4", "--flicker", "0.08"]),
+    ("overlap65", ["--seed", "45", "--overlap", "0.65", "--texture-style", "cells,noise,stripes"]),
+    ("brick", ["--seed", "46", "--texture-style", "brick"]),
+]
+FRAMES = "80"
+ROTATION_SCALE_KEY = "rotation_scale:"
+
+
+def quantile(values, q):
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
+
+
+def rotation_scale(tools):
+    """uncertainty.rotation_scale as shipped (oefmt_parameters --yaml)."""
+    text = subprocess.run([os.path.join(tools, "oefmt_parameters"), "--yaml"], check=True,
+                          capture_output=True, text=True).stdout
+    for line in text.splitlines():
+        if line.strip().startswith(ROTATION_SCALE_KEY):
+            return float(line.split(":")[1])
+    sys.exit("uncertainty.rotation_scale not found in oefmt_parameters --yaml")
+
+
+def ratios(tools, work, name, options, surface_scale):
+    folder = os.path.join(work, name)
+    if not os.path.isdir(folder):
+        subprocess.run([os.path.join(tools, "oefmt_simulate"), "--frames", FRAMES, *options, folder],
+                       check=True, stdout=subprocess.DEVNULL)
+    diagnostics = os.path.join(work, name + ".csv")
+    subprocess.run([os.path.join(tools, "oefmt_offline"), "--quiet", "--images", folder, "--mode", "oefmt",
+                    "--output", os.path.join(work, name + ".tum"), "--diagnostics", diagnostics],
+                   check=True, stdout=subprocess.DEVNULL)
+    surface, refined = [], []
+    with open(diagnostics, newline="") as table:
+        for row in csv.DictReader(table):
+            sigma_refined = float(row["sigma_refined_theta_rad"])
+            if row["state"] != "tracking" or not sigma_refined > 0.0:
+                continue
+            # A fixed heading: the true rotation of every pair is zero.
+            surface.append(abs(float(row["theta_rad"])) / (surface_scale * float(row["sigma_theta_rad"])))
+            refined.append(abs(float(row["refined_theta_rad"])) / sigma_refined)
+    return surface, refined
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    here = os.path.dirname(os.path.abspath(__file__))
+    parser.add_argument("--tools", default=os.path.join(here, "..", "build", "devel", "lib", "oefmt"))
+    parser.add_argument("--work", default=os.path.join(here, "..", "build", "calibration"))
+    args = parser.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    surface_scale = rotation_scale(args.tools)
+    all_surface, all_refined = [], []
+    for name, options in FLIGHTS:
+        surface, refined = ratios(args.tools, args.work, name, options, surface_scale)
+        if not surface:
+            print(f"{name:10s} no refined pair")
+            continue
+        print(f"{name:10s} {len(surface):3d} pairs: 90 % of errors within {quantile(surface, 0.9):.2f} surface "
+              f"sigmas, {quantile(refined, 0.9):.2f} refinement sigmas")
+        all_surface += surface
+        all_refined += refined
+    if not all_surface:
+        sys.exit("no refined pair in any flight")
+    q_surface, q_refined = quantile(all_surface, 0.9), quantile(all_refined, 0.9)
+    print(f"all        {len(all_surface):3d} pairs: {q_surface:.2f} surface sigmas, {q_refined:.2f} refinement "
+          f"sigmas -> refined_rotation_scale {q_refined / q_surface:.1f}")
+
+
+if __name__ == "__main__":
+    main()
