@@ -16,10 +16,10 @@ share of errors (90 %) lies within the sigma for both:
 """
 import argparse
 import csv
-import math
 import os
-import subprocess
 import sys
+
+import benchmark_common as common
 
 # Level circles with a fixed heading (the true rotation of every pair is zero), 80 frames each,
 # scenes unlike one another: the default one, natural texture, walls, weak texture, low overlap,
@@ -34,6 +34,7 @@ FLIGHTS = [
 ]
 FRAMES = "80"
 ROTATION_SCALE_KEY = "rotation_scale:"
+CALLER = "calibrate_rotation_sigma"
 
 
 def quantile(values, q):
@@ -43,23 +44,17 @@ def quantile(values, q):
 
 def rotation_scale(tools):
     """uncertainty.rotation_scale as shipped (oefmt_parameters --yaml)."""
-    text = subprocess.run([os.path.join(tools, "oefmt_parameters"), "--yaml"], check=True,
-                          capture_output=True, text=True).stdout
-    for line in text.splitlines():
+    for line in common.run([os.path.join(tools, "oefmt_parameters"), "--yaml"], CALLER).splitlines():
         if line.strip().startswith(ROTATION_SCALE_KEY):
             return float(line.split(":")[1])
     sys.exit("uncertainty.rotation_scale not found in oefmt_parameters --yaml")
 
 
 def ratios(tools, work, name, options, surface_scale):
-    folder = os.path.join(work, name)
-    if not os.path.isdir(folder):
-        subprocess.run([os.path.join(tools, "oefmt_simulate"), "--frames", FRAMES, *options, folder],
-                       check=True, stdout=subprocess.DEVNULL)
+    folder = common.render(tools, os.path.join(work, name), ["--frames", FRAMES, *options], CALLER)
     diagnostics = os.path.join(work, name + ".csv")
-    subprocess.run([os.path.join(tools, "oefmt_offline"), "--quiet", "--images", folder, "--mode", "oefmt",
-                    "--output", os.path.join(work, name + ".tum"), "--diagnostics", diagnostics],
-                   check=True, stdout=subprocess.DEVNULL)
+    common.run([os.path.join(tools, "oefmt_offline"), "--quiet", "--images", folder, "--mode", "oefmt",
+                "--output", os.path.join(work, name + ".tum"), "--diagnostics", diagnostics], CALLER)
     surface, refined = [], []
     with open(diagnostics, newline="") as table:
         for row in csv.DictReader(table):

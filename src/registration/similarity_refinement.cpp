@@ -297,11 +297,11 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     for (int a = parameters; a < kParameters; ++a) normal(a, a) = 1.0;  // rhs 0: no step
     Vector step;
     if (!cv::solve(normal, rhs, step, cv::DECOMP_CHOLESKY)) return out;
-    // How closely this step's pixels pin the motion: sigma^2 (J^T W J)^-1, the weights read as
-    // inverse variances (an approximation for the biweight's; calibrated by its user).
-    const Normal covariance = normal.inv(cv::DECOMP_CHOLESKY) * (sigma * sigma);
-    out.rotation_sigma = std::sqrt(std::max(covariance(0, 0), 0.0));
-    out.log_zoom_sigma = std::sqrt(std::max(covariance(1, 1), 0.0));
+    if (iteration + 1 == iterations) {
+      // How closely the last step's pixels pin the rotation: sigma^2 (J^T W J)^-1, the weights
+      // read as inverse variances (an approximation for the biweight's; calibrated by its user).
+      out.rotation_sigma = std::sqrt(std::max(normal.inv(cv::DECOMP_CHOLESKY)(0, 0) * (sigma * sigma), 0.0));
+    }
     current.rotation += step[0];
     current.log_zoom += step[1];
     current.translation.x += step[2];

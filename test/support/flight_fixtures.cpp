@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <mutex>
+#include <optional>
 
 #include "oefmt/sim/similarity_views.h"
 #include "oefmt/sim/texture.h"
@@ -110,6 +111,25 @@ void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, s
   t.stamp = p.stamp;
   t.position = Eigen::Vector3d(true_pose.position[0], true_pose.position[1], true_pose.position[2]);
   truth.push_back(t);
+}
+
+FlownPlan flyPlan(Estimator& estimator, const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames) {
+  FlownPlan flown;
+  double previous_yaw = 0.0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
+    if (!e) {
+      flown.refused.push_back(k);
+      continue;
+    }
+    if (k > 0) {
+      flown.heading_step_errors.push_back(
+          std::remainder((e->pose.yaw - previous_yaw) - (plan.poses[k].yaw - plan.poses[k - 1].yaw), 2.0 * M_PI));
+    }
+    previous_yaw = e->pose.yaw;
+    appendPositions(e->pose, plan.poses[k], k, flown.estimate, flown.truth);
+  }
+  return flown;
 }
 
 }  // namespace test

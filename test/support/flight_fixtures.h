@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "oefmt/estimation/estimator.h"
 #include "oefmt/estimation/estimator_config.h"
 #include "oefmt/evaluation/evaluation.h"
 #include "oefmt/sim/camera_model.h"
@@ -68,6 +69,18 @@ EstimatorConfig simulatedFlightConfig(const sim::FlightPlan& plan);
 /// with the index (for an evaluation that associates by index).
 void appendPositions(const Pose4& estimated, const sim::FlightPose& true_pose, std::size_t index,
                      StampedTrajectory& estimate, StampedTrajectory& truth);
+
+/// A simulator flight flown through an estimator.
+struct FlownPlan {
+  /// Each accepted frame's heading step (from the last accepted frame's) minus the true one
+  /// [rad, wrapped to (-pi, pi]].
+  std::vector<double> heading_step_errors;
+  StampedTrajectory estimate, truth;  ///< accepted frames, stamped by index (appendPositions)
+  std::vector<std::size_t> refused;   ///< frames the estimator did not take
+};
+
+/// Pushes `frames` (the plan's, in order) through `estimator` at the plan's stamps.
+FlownPlan flyPlan(Estimator& estimator, const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames);
 
 }  // namespace test
 }  // namespace oefmt

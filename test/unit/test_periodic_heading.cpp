@@ -40,26 +40,15 @@ FlightRun fly(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>& frames,
   EstimatorConfig config = test::simulatedFlightConfig(plan);
   config.tracking.max_yaw_rate = max_yaw_rate;
   Estimator estimator(config);
-  StampedTrajectory estimate, truth;
+  const test::FlownPlan flown = test::flyPlan(estimator, plan, frames);
+  for (const std::size_t k : flown.refused) ADD_FAILURE() << "frame " << k << " refused";
   FlightRun run;
-  double previous_yaw = 0.0;
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
-    if (!e) {
-      ADD_FAILURE() << "frame " << k << " refused";
-      continue;
-    }
-    if (k > 0) {
-      const double error = std::remainder((e->pose.yaw - previous_yaw) - (plan.poses[k].yaw - plan.poses[k - 1].yaw),
-                                          2.0 * M_PI);
-      run.worst_heading_step_deg = std::max(run.worst_heading_step_deg, std::fabs(error) * 180.0 / M_PI);
-    }
-    previous_yaw = e->pose.yaw;
-    test::appendPositions(e->pose, plan.poses[k], k, estimate, truth);
+  for (const double error : flown.heading_step_errors) {
+    run.worst_heading_step_deg = std::max(run.worst_heading_step_deg, std::fabs(error) * 180.0 / M_PI);
   }
   EvaluationOptions options;
   options.association = AssociationMode::kIndex;
-  run.drift_percent = evaluateTrajectory(estimate, truth, options).drift_percent;
+  run.drift_percent = evaluateTrajectory(flown.estimate, flown.truth, options).drift_percent;
   return run;
 }
 

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <vector>
 
 #include "oefmt/estimation/estimator.h"
@@ -33,21 +34,11 @@ double headingBiasBins(const sim::FlightPlan& plan, const std::vector<cv::Mat1b>
   EstimatorConfig config = test::simulatedFlightConfig(plan);
   config.uncertainty.refined_rotation_scale = refined_rotation_scale;
   Estimator estimator(config);
-  double sum = 0.0, previous = 0.0;
-  int steps = 0;
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
-    if (!e) {
-      ADD_FAILURE() << "frame " << k << " refused";
-      continue;
-    }
-    if (k > 0) {
-      sum += std::remainder((e->pose.yaw - previous) - (plan.poses[k].yaw - plan.poses[k - 1].yaw), 2.0 * CV_PI);
-      ++steps;
-    }
-    previous = e->pose.yaw;
-  }
-  return steps > 0 ? sum / steps * config.registration.size / CV_PI : 0.0;
+  const test::FlownPlan flown = test::flyPlan(estimator, plan, frames);
+  for (const std::size_t k : flown.refused) ADD_FAILURE() << "frame " << k << " refused";
+  const std::vector<double>& errors = flown.heading_step_errors;
+  if (errors.empty()) return 0.0;
+  return std::accumulate(errors.begin(), errors.end(), 0.0) / errors.size() * config.registration.size / CV_PI;
 }
 
 TEST(SteadyTurnHeading, TheRefinedRotationTakesOutTheSurfacesSubBinBias) {

@@ -45,11 +45,10 @@ struct SimilarityRefinement {
   /// start and at the refined motion (negative: too few pixels): the fit improved when it fell.
   double loss_start = -1.0;
   double loss_end = -1.0;
-  /// Standard deviations of the rotation [rad] and log zoom the last step solved for, from its
-  /// normal equations and the residuals' robust sigma (0: no step was solved). They describe the
-  /// pixels' noise, not a model that does not fit (several depth layers): calibrate before use.
+  /// Standard deviation of the rotation [rad] the last step solved for, from its normal
+  /// equations and the residuals' robust sigma (0: no step was solved). It describes the pixels'
+  /// noise, not a model that does not fit (several depth layers): calibrate before use.
   double rotation_sigma = 0.0;
-  double log_zoom_sigma = 0.0;
 };
 
 /// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see, weighted by
