@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/estimation/estimator.h"
+#include "oefmt/estimation/layer_ratio_memory.h"
 #include "oefmt/estimation/range_gate.h"
 
 #include <algorithm>
@@ -46,6 +47,16 @@ constexpr double kPriorWindowBins = 6.0;
 // Steps whose median predicts the next rotation and zoom: a yaw or climb rate that changes
 // shows in the median after two steps, a single wrong step not at all.
 constexpr std::size_t kPredictionSteps = 3;
+// The layer ratios a step must keep (LayerRatioMemory): held in 8 of the last 12 measured steps
+// to within 1 %. A layer's peak sits to a few tenths of a per cent, and a depth ratio moves with
+// the altitude only: a climb of 3 % of the altitude over those steps (a steep one) moves a roof at
+// 30 % of it against the ground by 1 %, after which the older steps no longer support the ratio
+// (the memory falls silent rather than wrong). 8 of 12 let a layer be missing from a few pairs'
+// vectors, and keep a run of a few wrong steps (a periodic texture's alias) from becoming a ratio
+// that then holds the steps back from their return to the right length.
+constexpr int kLayerRatioFrames = 12;
+constexpr int kLayerRatioSupport = 8;
+constexpr double kLayerRatioTolerance = 0.01;
 // Smallest radius of the translation window [px]: sub-pixel noise and rounding.
 constexpr double kTranslationWindowFloor = 2.0;
 
@@ -99,6 +110,7 @@ struct Estimator::State {
     recent_steps.clear();
     recent_rates.clear();
     plane_tilt.clear();
+    layer_ratios.clear();
     levelled = false;
     implausible_steps = 0;
     unconfirmed_steps = 0;
@@ -107,6 +119,7 @@ struct Estimator::State {
   }
   void forgetPair01() {
     have01 = false;
+    layer_ratios.clear();
     translation01.clear();
     zoom01.clear();
   }
@@ -129,6 +142,11 @@ struct Estimator::State {
   // that covers the difference, and marked degraded; after tracking.max_failed_frames such steps
   // in a row the measurements are believed and the motion model starts over.
   PairMotion plausibleStep(const PairMotion& step, Estimate& est);
+  // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
+  // breaks their ratios by more than tracking.layer_gate.
+  PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
+  // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
+  std::vector<double> layerShifts(const PairRegistration& registration) const;
   // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
   // registered: even its slowest layer (of those pair 0-1 saw) must stay within
   // kMaxPairShiftFraction of N along both axes.
@@ -195,6 +213,8 @@ struct Estimator::State {
   std::deque<PairMotion> recent_steps;
   std::deque<PairMotion> recent_rates;  // of those, the steps whose rotation/zoom were measured
   int implausible_steps = 0;  // steps in a row replaced by the prediction (plausibleStep)
+  // The followed layer's length against the layers in view over the last measured steps.
+  LayerRatioMemory layer_ratios{kLayerRatioFrames, kLayerRatioSupport, kLayerRatioTolerance};
   int unconfirmed_steps = 0;  // steps in a row that did not enter recent_steps
   bool started = false;
   double last_stamp = -std::numeric_limits<double>::infinity();
@@ -585,6 +605,7 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
   if (!est.step_implausible && est.translation_use12 != PairObservations::TranslationUse::kNone) {
     recent_steps.push_back(*last_step);
     if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
+    layer_ratios.remember(step.shift(), layerShifts(est.registration12));
     if (est.registration12.rotation_zoom_candidate != PairRegistration::kPredicted) {
       recent_rates.push_back(*last_step);
       if (recent_rates.size() > kPredictionSteps) recent_rates.pop_front();
@@ -606,6 +627,37 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
   anchor.reset();
   f0 = std::move(f1);
   f1 = std::move(frame);
+}
+
+std::vector<double> Estimator::State::layerShifts(const PairRegistration& registration) const {
+  std::vector<double> shifts;
+  const double shift_per_bin = registrar.shiftPerBin();
+  for (const EnergyPeak& peak : energyPeaks(registration.translation_energy, config.tracking.layer_min_fraction)) {
+    shifts.push_back(peak.bin * shift_per_bin);
+  }
+  return shifts;
+}
+
+PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) const {
+  const double length = step.shift();
+  if (config.mode != EstimatorMode::kOefmt || !have01 || !(length > 0.0)) return step;
+  const double steady = motion01.shift() * est.frame_gap / gap01;
+  const std::optional<double> vouched = layer_ratios.vouchedLength(layerShifts(est.registration12), steady);
+  if (!vouched || std::fabs(length - *vouched) <= config.tracking.layer_gate * *vouched) return step;
+  // The layers mend a step that broke away from the motion so far, and never move one that held
+  // to it: a periodic texture's aliases hold ratios of their own, and the lengths they vouch for
+  // jump.
+  if (!(std::fabs(*vouched - steady) < std::fabs(length - steady))) return step;
+  est.vouched_length = *vouched;
+  const double along = alongTrackSigma(step);
+  const double across = std::sqrt(std::max(cv::trace(step.translation_covariance) - along * along, 0.0));
+  PairMotion out = step;
+  const double direction = step.direction();
+  out.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * *vouched;
+  out.translation_covariance =
+      alongAcrossCovariance(direction, std::max(kLayerRatioTolerance * *vouched, detail::kMinShiftSigma),
+                            std::max(across * *vouched / length, detail::kMinShiftSigma));
+  return out;
 }
 
 Estimator::Estimator(const EstimatorConfig& config) : config_(config) {
@@ -791,7 +843,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       } else if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01) {
         step = s.oefmtStep(frame, est, with02);
       }
-      if (config_.mode == EstimatorMode::kOefmt) step = s.plausibleStep(step, est);
+      if (config_.mode == EstimatorMode::kOefmt) step = s.plausibleStep(s.vouchedStep(step, est), est);
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }
   }

@@ -80,6 +80,10 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        "distance of the step's other length readings (PMT stretch, highest peak) from the integrated "
        "length, added to the pose's covariance along the step; 0 when they agree",
        [](const Estimate& e) { return format("%.4f", e.length_spread); }},
+      {"vouched_length_px", "px",
+       "oefmt: the step length the depth layers in view vouched for by the ratios they held over the last "
+       "steps, where the step's own broke them and was replaced by it; 0 = the step's own length stood",
+       [](const Estimate& e) { return format("%.4f", e.vouched_length); }},
       {"plane_tilt_x_rad", "rad",
        "levelled frames: the ground plane's tilt left in the level view, its normal's component "
        "along the image's x axis (the attitude's error as the pairs' stretch read it; the zooms "

@@ -83,6 +83,9 @@ struct Estimate {
   /// noise within the acceleration window (detail::lengthSpread); added to the pose's covariance
   /// along the step. 0 when they agree.
   double length_spread = 0.0;
+  /// The length the layers in view vouched for where the step's own broke their ratios and was
+  /// replaced by it [px]; 0 = the step's own length stood.
+  double vouched_length = 0.0;
   /// Levelled frames (setLevelled), oefmt mode: the tilt of the ground plane left in the level
   /// view [rad, the frame's image axes: x right, y down], as the pairs' stretch read it, for
   /// which this frame's refined zooms were corrected: the attitude source's error, seen from the
