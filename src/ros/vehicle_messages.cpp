@@ -88,7 +88,12 @@ ImuSample imuSample(const sensor_msgs::Imu& message) {
                                        message.orientation.z)
                         .normalized();
   }
-  s.angular_velocity = {message.angular_velocity.x, message.angular_velocity.y, message.angular_velocity.z};
+  // A covariance of -1 says the rates were not measured (sensor_msgs/Imu): NaN, which the gyro's
+  // user (TurnHistory) takes as no reading, not as a vehicle that does not turn.
+  s.angular_velocity = message.angular_velocity_covariance[0] == -1.0
+                           ? Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN())
+                           : Eigen::Vector3d(message.angular_velocity.x, message.angular_velocity.y,
+                                             message.angular_velocity.z);
   s.linear_acceleration = {message.linear_acceleration.x, message.linear_acceleration.y,
                            message.linear_acceleration.z};
   return s;

@@ -13,8 +13,10 @@
 #include <rosbag/bag.h>
 
 #include "support/temp_dir.h"
+#include "oefmt/estimation/attitude.h"
 #include "oefmt/io/dataset.h"
 #include "oefmt/ros/bag_io.h"
+#include "oefmt/ros/vehicle_messages.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/folder_writer.h"
 
@@ -444,6 +446,27 @@ TEST(BagIo, SimulatorBagCarriesTheFlightsCamera) {
   ASSERT_TRUE(reader.next(frame));
   EXPECT_EQ(frame.encoding, "mono8");
   EXPECT_DOUBLE_EQ(frame.stamp, plan.stamps[0]);
+}
+
+TEST(BagIo, AnImuWithoutRatesGivesNoGyroTurn) {
+  ImuSample truth;
+  truth.stamp = 1.0;
+  truth.angular_velocity = {0.0, 0.0, 0.4};  // turning at 0.4 rad/s
+  sensor_msgs::Imu message = imuMessage(truth, "imu");
+  const ImuSample with_rates = imuSample(message);
+  EXPECT_DOUBLE_EQ(with_rates.angular_velocity.z(), 0.4);
+  // sensor_msgs/Imu: a covariance of -1 says the element was not measured. Read as zero rates,
+  // the gyro would say the vehicle holds its heading, and every pair would be searched there.
+  message.angular_velocity_covariance[0] = -1.0;
+  const ImuSample without = imuSample(message);
+  EXPECT_TRUE(without.angular_velocity.array().isNaN().all());
+  TurnHistory turns;
+  for (int k = 0; k <= 40; ++k) {
+    ImuSample s = without;
+    s.stamp = 1.0 + 0.005 * k;
+    turns.add(s.stamp, s.orientation, s.angular_velocity);
+  }
+  EXPECT_FALSE(turns.turn(1.0, 1.2).has_value());
 }
 
 }  // namespace

@@ -26,7 +26,8 @@ struct ImuNoise {
 
 sensor_msgs::Imu imuMessage(const ImuSample& sample, const std::string& frame_id, const ImuNoise& noise = {});
 /// The sample of a message (its header stamp). A message without orientation (covariance[0] = -1,
-/// as sensor_msgs/Imu has it) gives the identity; check hasOrientation first.
+/// as sensor_msgs/Imu has it) gives the identity; check hasOrientation first. One without angular
+/// velocity (its covariance[0] = -1) gives NaN rates.
 ImuSample imuSample(const sensor_msgs::Imu& message);
 bool hasOrientation(const sensor_msgs::Imu& message);
 
