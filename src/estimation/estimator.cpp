@@ -143,7 +143,7 @@ struct Estimator::State {
   // in a row the measurements are believed and the motion model starts over.
   PairMotion plausibleStep(const PairMotion& step, Estimate& est);
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
-  // breaks their ratios by more than tracking.layer_gate.
+  // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
   std::vector<double> layerShifts(const PairRegistration& registration) const;
@@ -605,7 +605,7 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
   if (!est.step_implausible && est.translation_use12 != PairObservations::TranslationUse::kNone) {
     recent_steps.push_back(*last_step);
     if (recent_steps.size() > kPredictionSteps) recent_steps.pop_front();
-    layer_ratios.remember(step.shift(), layerShifts(est.registration12));
+    if (config.mode == EstimatorMode::kOefmt) layer_ratios.remember(step.shift(), layerShifts(est.registration12));
     if (est.registration12.rotation_zoom_candidate != PairRegistration::kPredicted) {
       recent_rates.push_back(*last_step);
       if (recent_rates.size() > kPredictionSteps) recent_rates.pop_front();
@@ -640,7 +640,7 @@ std::vector<double> Estimator::State::layerShifts(const PairRegistration& regist
 
 PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) const {
   const double length = step.shift();
-  if (config.mode != EstimatorMode::kOefmt || !have01 || !(length > 0.0)) return step;
+  if (!have01 || !(length > 0.0)) return step;
   const double steady = motion01.shift() * est.frame_gap / gap01;
   const std::optional<double> vouched = layer_ratios.vouchedLength(layerShifts(est.registration12), steady);
   if (!vouched || std::fabs(length - *vouched) <= config.tracking.layer_gate * *vouched) return step;
@@ -651,13 +651,8 @@ PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) 
   est.vouched_length = *vouched;
   const double along = alongTrackSigma(step);
   const double across = std::sqrt(std::max(cv::trace(step.translation_covariance) - along * along, 0.0));
-  PairMotion out = step;
-  const double direction = step.direction();
-  out.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * *vouched;
-  out.translation_covariance =
-      alongAcrossCovariance(direction, std::max(kLayerRatioTolerance * *vouched, detail::kMinShiftSigma),
+  return detail::withLength(step, *vouched, std::max(kLayerRatioTolerance * *vouched, detail::kMinShiftSigma),
                             std::max(across * *vouched / length, detail::kMinShiftSigma));
-  return out;
 }
 
 Estimator::Estimator(const EstimatorConfig& config) : config_(config) {

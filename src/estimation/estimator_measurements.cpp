@@ -14,15 +14,6 @@ constexpr double kMinLogZoomSigma = 1e-5;
 
 double finiteOr(double v, double fallback) { return std::isfinite(v) ? v : fallback; }
 
-// `motion` moved to `length` along its own direction, with 1-sigmas along and across it.
-PairMotion withLength(const PairMotion& motion, double length, double along, double across) {
-  PairMotion out = motion;
-  const double direction = motion.direction();
-  out.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
-  out.translation_covariance = alongAcrossCovariance(direction, along, across);
-  return out;
-}
-
 // Smallest gate [px] between the followed layer's predicted and measured shift: sub-pixel noise.
 constexpr double kMinLayerGatePx = 1.5;
 
@@ -106,6 +97,14 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
 }
 
 }  // namespace
+
+PairMotion withLength(const PairMotion& motion, double length, double along, double across) {
+  PairMotion out = motion;
+  const double direction = motion.direction();
+  out.translation = cv::Point2d(std::cos(direction), std::sin(direction)) * length;
+  out.translation_covariance = alongAcrossCovariance(direction, along, across);
+  return out;
+}
 
 PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
   PairMotion m;

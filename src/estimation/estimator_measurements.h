@@ -22,6 +22,9 @@ PairMotion calibrated(const PairRegistration& registration, const UncertaintyCon
 /// 1-sigma of |d| (along d) of a motion's translation.
 double alongTrackSigma(const PairMotion& motion);
 
+/// `motion` moved to `length` along its own direction, with 1-sigmas along and across it.
+PairMotion withLength(const PairMotion& motion, double length, double along, double across);
+
 /// The motion of one frame interval from a motion spanning `gap` intervals.
 PairMotion perInterval(const PairMotion& motion, int gap);
 
