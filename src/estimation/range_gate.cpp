@@ -7,6 +7,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "oefmt/registration/warp.h"
+
 namespace oefmt {
 
 RangeGate::RangeGate(double gate, int relock_after) : gate_(gate), relock_after_(std::max(1, relock_after)) {}
@@ -97,7 +99,7 @@ std::optional<double> centreDepthRatio(const cv::Mat1f& older, const cv::Mat1f& 
   // that would appear there if it moved with the followed layer (whole pixels).
   const cv::Point shift(static_cast<int>(std::lround(motion.translation.x)),
                         static_cast<int>(std::lround(motion.translation.y)));
-  const double c = n / 2;
+  const double c = imageCentre(n);
   if (!std::isfinite(beam.x) || !std::isfinite(beam.y)) return std::nullopt;
   const cv::Rect newer_rect(static_cast<int>(std::lround(c + beam.x)) - patch / 2,
                             static_cast<int>(std::lround(c + beam.y)) - patch / 2, patch, patch);

@@ -394,52 +394,63 @@ double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistrati
   return peakToSidelobeRatio(surface, peak, rotation_zoom_stats_);
 }
 
-double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
-                                      RegistrationMethod method, PairRegistration& result,
-                                      bool test_half_turn, const RegistrationPrior* prior) {
+void Registrar::warpOlder(const FrameSpectra& older, PairRegistration& result) {
+  // Bring the older frame onto the newer one's rotation and zoom. Unless that moves no pixel
+  // noticeably: then the older frame's own spectrum (the same apodized, mean-free image) serves,
+  // and the warp and its FFT are saved.
   const int n = context_->size();
-  // Bring the older frame onto the newer one's rotation and zoom, then correlate.
-  // Unless that moves no pixel noticeably: then the older frame's own spectrum (the same
-  // apodized, mean-free image) serves, and the warp and its FFT are saved.
-  const Fft2d& fft = context_->fft();
   const double corner = std::sqrt(0.5) * n;
   const double moved = corner * std::abs(std::polar(result.zoom, result.rotation) - 1.0);
   result.warped = !(moved <= context_->config().identity_warp_px);
   if (result.warped) {
+    const Fft2d& fft = context_->fft();
     cv::Mat1f warped = fft.inPlaceInput(warped_spectrum_);
     warpSimilarityWindowed(older.grey, result.rotation, result.zoom, context_->window(), warped,
                            older.mean);
     fft.forwardInPlace(warped_spectrum_);
   }
-  const cv::Mat2f& older_spectrum = result.warped ? warped_spectrum_ : older.spectrum;
+}
 
-  if (test_half_turn && context_->config().resolve_half_turn && prior != nullptr) {
-    // The surface reads the rotation modulo a half turn: the prediction says which.
+double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
+                                      RegistrationMethod method, PairRegistration& result,
+                                      bool test_half_turn, const RegistrationPrior* prior) {
+  const int n = context_->size();
+  // The surface reads the rotation modulo a half turn. The prediction says which; or the
+  // vehicle cannot have turned by a quarter turn, and the smaller of the two holds (the
+  // surface's rotation lies within a quarter turn of zero).
+  const bool resolve = test_half_turn && context_->config().resolve_half_turn;
+  if (resolve && prior != nullptr) {
     if (std::fabs(wrapAngle(result.rotation - prior->rotation)) > CV_PI / 2.0) {
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
     }
-  } else if (test_half_turn && context_->config().resolve_half_turn && max_rotation_ < CV_PI / 2.0) {
-    // The vehicle cannot have turned by a quarter turn: the smaller of the two rotations. (The
-    // surface's rotation lies within a quarter turn of zero.)
+  } else if (resolve && max_rotation_ < CV_PI / 2.0) {
     result.half_turn = false;
-  } else if (test_half_turn && context_->config().resolve_half_turn) {
-    // A half turn about the centre conjugates the spectrum of a real image, so the theta + pi
-    // hypothesis needs no second warp; a low-resolution correlation decides between the two
-    // and only the winner gets the full-size inverse FFT.
-    const double same = lowResolutionPeak(newer.spectrum, older_spectrum, false,
-                                          context_->smallFft(), small_spectrum_, small_surface_);
-    const double turned = lowResolutionPeak(newer.spectrum, older_spectrum, true,
-                                            context_->smallFft(), small_spectrum_, small_surface_);
+  }
+  warpOlder(older, result);
+  if (resolve && prior == nullptr && !(max_rotation_ < CV_PI / 2.0)) {
+    // A half turn about the FFT's origin conjugates the spectrum of a real image, so the theta + pi
+    // hypothesis is tested without a second warp, by a low-resolution correlation. That half
+    // turn is about pixel (N/2, N/2), not about the image centre the motion is given about: the
+    // winner is warped by its own rotation.
+    const cv::Mat2f& warped = result.warped ? warped_spectrum_ : older.spectrum;
+    const double same = lowResolutionPeak(newer.spectrum, warped, false, context_->smallFft(),
+                                          small_spectrum_, small_surface_);
+    const double turned = lowResolutionPeak(newer.spectrum, warped, true, context_->smallFft(),
+                                            small_spectrum_, small_surface_);
     if (turned > same) {
       result.half_turn = true;
       result.rotation = wrapAngle(result.rotation + CV_PI);
+      warpOlder(older, result);
     }
   }
+  const cv::Mat2f& older_spectrum = result.warped ? warped_spectrum_ : older.spectrum;
+
   // The older frame's noise power also stands for its warp (whose bilinear resampling lowers the
   // noise at high frequencies a little: those are weighted down a little more).
   const float older_noise = context_->config().noise_weighting ? older.noise_power : 0.0f;
-  centredCrossPower(newer.spectrum, older_spectrum, cross_power_, result.half_turn,
+  const Fft2d& fft = context_->fft();
+  centredCrossPower(newer.spectrum, older_spectrum, cross_power_, false,
                     SimdKernel::kAuto, newer.noise_power, older_noise);
   fft.inverseInPlace(cross_power_);
   surface_ = fft.realView(cross_power_);

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/registration/warp.h"
 
 namespace oefmt {
 namespace {
@@ -56,7 +57,7 @@ bool bilinear(const cv::Mat1f& image, double x, double y, double& value, double&
 // The motion as the inverse map of the newer frame's pixels into the older one's.
 struct InverseMap {
   double c, tx, ty, i00, i01, i10, i11;
-  InverseMap(const ImageSimilarity& m, int n) : c(n / 2) {
+  InverseMap(const ImageSimilarity& m, int n) : c(imageCentre(n)) {
     const double s = std::exp(m.log_zoom);
     const double cs = std::cos(m.rotation), sn = std::sin(m.rotation);
     // A(c + M^-1 (x - d - c)), M = (I + S) s R(theta), R = [cos sin; -sin cos] (y down,

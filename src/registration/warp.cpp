@@ -65,7 +65,7 @@ void warpSimilarityWindowed(const cv::Mat1f& source, double rotation, double zoo
   // Inverse map (output -> source). Screen counter-clockwise with y down is the matrix
   // [cos sin; -sin cos] (OpenCV's getRotationMatrix2D); its inverse divided by zoom:
   const double c = std::cos(rotation) / zoom, s = std::sin(rotation) / zoom;
-  const double cx = cols / 2, cy = rows / 2;
+  const double cx = imageCentre(cols), cy = imageCentre(rows);
   const float a00 = static_cast<float>(c), a01 = static_cast<float>(-s);
   const float a10 = static_cast<float>(s), a11 = static_cast<float>(c);
   const int stride = static_cast<int>(source.step1());

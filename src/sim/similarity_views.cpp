@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/registration/warp.h"
 
 namespace oefmt {
 namespace sim {
@@ -17,7 +18,7 @@ cv::Mat1f renderView(const cv::Mat1f& texture, cv::Point2d texture_centre, const
   // Inverse map: texture(tc + M^-1 (x_new - c - shift)), M = zoom * R(rotation).
   const double c = std::cos(motion.rotation) / motion.zoom;
   const double s = std::sin(motion.rotation) / motion.zoom;
-  const cv::Point2d centre(n / 2.0, n / 2.0);
+  const cv::Point2d centre(imageCentre(n), imageCentre(n));
   const cv::Point2d origin = centre + motion.shift;
   cv::Matx23d inverse(c, -s, 0.0, s, c, 0.0);
   inverse(0, 2) = texture_centre.x - (c * origin.x - s * origin.y);

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstddef>
+#include <memory>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -10,6 +12,8 @@
 #include "oefmt/error.h"
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/registration/registration.h"
+#include "oefmt/sim/flight.h"
+#include "oefmt/sim/renderer.h"
 #include "oefmt/sim/texture.h"
 #include "support/fixtures.h"
 
@@ -119,6 +123,33 @@ TEST_P(PureRotation, AngleWithinFiveHundredthsOfADegree) {
 INSTANTIATE_TEST_SUITE_P(Rotations, PureRotation,
                          ::testing::Values(1.3, -4.0, 10.6, -27.0, 45.0, -62.5, 85.0, 120.0,
                                            -135.0, 170.0, -178.0));
+
+// A camera that only yaws turns its view about the principal point, which the simulator (like
+// the undistorter) puts at the middle of the image, (N - 1) / 2. Registered about any other
+// point, every yaw of theta would read as a shift of theta times the distance between the two
+// (0.19 px at 15 degrees for a point half a pixel off in x and y), which a yawing flight
+// integrates into a sideways drift.
+TEST(Registration, AYawAboutThePrincipalPointGivesNoShift) {
+  sim::FlightOptions options;
+  options.width = options.height = 256;
+  options.track.shape = sim::TrackShape::kSpin;
+  options.track.frames = 4;
+  options.track.spin_rate = rad(-15.0);
+  options.flat = true;
+  options.texture_size = 1024;
+  options.seed = 23;
+  const sim::FlightPlan plan = sim::planFlight(options);
+  const sim::Renderer renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, plan.supersample);
+  cv::Mat1f older = renderer.render(plan.poses[0]).image;
+  for (std::size_t k = 1; k < plan.poses.size(); ++k) {
+    const cv::Mat1f newer = renderer.render(plan.poses[k]).image;
+    const PairRegistration r = test::registerImages(older, newer);
+    ASSERT_EQ(r.status, RegistrationStatus::kOk) << k;
+    EXPECT_NEAR(std::fabs(deg(r.rotation)), 15.0, 0.05) << k;
+    EXPECT_LT(r.shift, 0.05) << k << ": " << r.translation;
+    older = newer;
+  }
+}
 
 class PureZoom : public ::testing::TestWithParam<double> {};
 

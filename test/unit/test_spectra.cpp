@@ -229,12 +229,12 @@ TEST(Warp, NonFiniteOrExtremeTransformsGiveFiniteOutput) {
   }
 }
 
-TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheCentre) {
+TEST(Warp, HalfTurnMapsPixelsOntoTheirMirrorAboutTheImageCentre) {
   const SeparableWindow flat(64, 0.0);  // no taper: compare raw pixels
   cv::Mat1f image(64, 64, 0.0f), turned;
   image(10, 20) = 1.0f;
   warpSimilarityWindowed(image, CV_PI, 1.0, flat, turned);
-  EXPECT_NEAR(turned(64 - 10, 64 - 20), 1.0f, 1e-4);  // x -> N - x about (N/2, N/2)
+  EXPECT_NEAR(turned(63 - 10, 63 - 20), 1.0f, 1e-4);  // x -> N - 1 - x about ((N-1)/2, (N-1)/2)
   EXPECT_NEAR(cv::sum(turned)[0], 1.0, 1e-4);
 }
 

@@ -12,8 +12,8 @@
 namespace oefmt {
 
 /// Motion of an older frame A to a newer frame B, in the conventions of PairRegistration:
-/// x_B - c = s R(theta) (x_A - c) + d, image axes (x right, y down), theta > 0 turns B's content
-/// counter-clockwise on screen, d in B's pixels. The camera itself moved by -R(theta) d / s in
+/// x_B - c = s R(theta) (x_A - c) + d, c = imageCentre(N) (the principal point), image axes
+/// (x right, y down), theta > 0 turns B's content counter-clockwise on screen, d in B's pixels. The camera itself moved by -R(theta) d / s in
 /// A's pixels, where R(a) adds a to image angles atan2(dy, dx).
 struct PairMotion {
   double rotation = 0.0;   ///< theta [rad], in (-pi, pi]

@@ -32,7 +32,8 @@ inline constexpr EnumName<RegistrationStatus> kRegistrationStatusNames[] = {
 inline const char* toString(RegistrationStatus status) { return enumName(kRegistrationStatusNames, status); }
 
 /// The registration of an older frame A to a newer frame B.
-/// Axes: x right, y down (image). Angles: atan2(dy, dx) in these axes.
+/// Axes: x right, y down (image). Angles: atan2(dy, dx) in these axes. Rotation and zoom are
+/// about imageCentre(N) (warp.h), the principal point of the working frame.
 struct PairRegistration {
   RegistrationStatus status = RegistrationStatus::kTextureless;
   double rotation = 0.0;     ///< theta [rad]: B is A rotated counter-clockwise on screen, (-pi, pi]
@@ -195,6 +196,9 @@ class Registrar {
   void registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
                        const RegistrationPrior& prior, PairRegistration& result,
                        RegistrationSurfaces* surfaces);
+  // warped_spectrum_: the older frame warped by the result's rotation and zoom and transformed
+  // (result.warped false: it would move no pixel noticeably, and was not warped).
+  void warpOlder(const FrameSpectra& older, PairRegistration& result);
   // The translation's confidence (0..1) instead of a peak-to-sidelobe ratio.
   double registerTranslation(const FrameSpectra& older, const FrameSpectra& newer,
                              RegistrationMethod method, PairRegistration& result,
