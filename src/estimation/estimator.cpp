@@ -145,6 +145,9 @@ struct Estimator::State {
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
+  // A registration too weak to use on its own whose layers in view still vouch (by the ratios
+  // they held) for the length the motion so far predicts: that step (oefmt mode).
+  std::optional<PairMotion> corroboratedStep(Estimate& est) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
   std::vector<double> layerShifts(const PairRegistration& registration) const;
   // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
@@ -655,6 +658,33 @@ PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) 
                             std::max(across * *vouched / length, detail::kMinShiftSigma));
 }
 
+std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) const {
+  // Where one depth layer fills most of the view, its texture (oriented, periodic) can leave the
+  // translation peak too flat to trust on its own, while the layers in its energy vector still
+  // stand at the depth ratios they held. A length they vouch for that the motion so far also
+  // predicts (within twice the ratios' own tolerance) is two independent readings agreeing: the
+  // pair is tracked on it instead of being lost. A noise peak would need to fall, with its
+  // direction, in the acceleration window and at a held ratio of the predicted length.
+  const PairRegistration& r = est.registration12;
+  if (!have01 || !prior12 || !(prior12->translation_radius > 0.0) ||
+      r.status != RegistrationStatus::kLowConfidence || !(r.confidence > 0.0) ||
+      r.rotation_zoom_implausible || !(r.shift > 0.0)) {
+    return std::nullopt;
+  }
+  const double steady = motion01.shift() * est.frame_gap / gap01;
+  const std::optional<LayerRatioMemory::Vouched> vouched = layer_ratios.vouch(layerShifts(r), steady);
+  if (!vouched || !(std::fabs(vouched->length - steady) <= 2.0 * kLayerRatioTolerance * steady)) return std::nullopt;
+  const PairMotion measured = detail::calibrated(r, config.uncertainty);
+  const double along = alongTrackSigma(measured);
+  const double across = std::sqrt(std::max(cv::trace(measured.translation_covariance) - along * along, 0.0));
+  const PairMotion step = detail::withLength(
+      measured, vouched->length, std::max(kLayerRatioTolerance * vouched->length, detail::kMinShiftSigma),
+      std::max(across * vouched->length / r.shift, detail::kMinShiftSigma));
+  if (!(cv::norm(step.translation - prior12->translation) <= prior12->translation_radius)) return std::nullopt;
+  est.vouched_length = vouched->length;
+  return step;
+}
+
 Estimator::Estimator(const EstimatorConfig& config) : config_(config) {
   config_.validate();
   state_ = std::make_unique<State>(config_, std::make_shared<const SpectralContext>(config_.modeRegistration()));
@@ -825,7 +855,17 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       }
     }
     est.registration_ms += msSince(t);
-    if (!est.registration12.usable()) {
+    std::optional<PairMotion> corroborated;
+    if (!est.registration12.usable() && config_.mode == EstimatorMode::kOefmt) corroborated = s.corroboratedStep(est);
+    if (corroborated) {
+      // Pair 0-2 and the loop are left out: they would be weighed against this weak pair.
+      if (s.pending02.valid()) s.pending02.wait();
+      s.pending02 = {};
+      est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
+      est.degraded = true;
+      std::vector<float> next_translation01 = est.registration12.translation_energy;
+      s.advance(std::move(frame), *corroborated, std::move(next_translation01), est);
+    } else if (!est.registration12.usable()) {
       if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below
       s.pending02 = {};
       s.registrationFailed(std::move(frame), textured, est);

@@ -54,6 +54,13 @@ std::vector<double> LayerRatioMemory::heldRatios() const {
 
 std::optional<double> LayerRatioMemory::vouchedLength(const std::vector<double>& layer_shifts,
                                                       double steady) const {
+  const std::optional<Vouched> vouched = vouch(layer_shifts, steady);
+  if (!vouched) return std::nullopt;
+  return vouched->length;
+}
+
+std::optional<LayerRatioMemory::Vouched> LayerRatioMemory::vouch(const std::vector<double>& layer_shifts,
+                                                                 double steady) const {
   const std::vector<double> ratios = heldRatios();
   std::vector<double> lengths;
   for (double ratio : ratios) {
@@ -64,8 +71,7 @@ std::optional<double> LayerRatioMemory::vouchedLength(const std::vector<double>&
   // Each length's votes: the ratio-layer pairs that give it; a wrong pairing gives a length of
   // its own, the right ones agree. Of the lengths with the most votes, the one nearest `steady`
   // (with one layer in view, its ratios give as many lengths, one vote each).
-  std::optional<double> best;
-  int best_votes = 0;
+  std::optional<Vouched> best;
   std::vector<bool> counted(lengths.size(), false);
   for (std::size_t i = 0; i < lengths.size(); ++i) {
     if (counted[i]) continue;
@@ -79,9 +85,9 @@ std::optional<double> LayerRatioMemory::vouchedLength(const std::vector<double>&
       }
     }
     const double length = sum / votes;
-    if (votes > best_votes || (votes == best_votes && std::fabs(length - steady) < std::fabs(*best - steady))) {
-      best_votes = votes;
-      best = length;
+    if (!best || votes > best->votes ||
+        (votes == best->votes && std::fabs(length - steady) < std::fabs(best->length - steady))) {
+      best = Vouched{length, votes};
     }
   }
   return best;

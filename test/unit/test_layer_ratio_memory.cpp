@@ -54,6 +54,22 @@ TEST(LayerRatioMemory, TwoLayersThatAgreeOutvoteTheNearestLength) {
   EXPECT_NEAR(*vouched, 100.0, 1e-9);
 }
 
+TEST(LayerRatioMemory, VouchCountsThePairsThatGiveTheLength) {
+  LayerRatioMemory memory(kFrames, kSupport, kTolerance);
+  for (int k = 0; k < kFrames; ++k) memory.remember(100.0, {100.0, 80.0});
+  const std::optional<LayerRatioMemory::Vouched> both = memory.vouch({100.0, 80.0}, 81.0);
+  ASSERT_TRUE(both.has_value());
+  EXPECT_NEAR(both->length, 100.0, 1e-9);
+  EXPECT_EQ(both->votes, 2);
+  // Only the roof in view: each ratio gives a length of its own, one vote each; the one nearest
+  // the motion so far.
+  const std::optional<LayerRatioMemory::Vouched> roof = memory.vouch({80.0}, 97.0);
+  ASSERT_TRUE(roof.has_value());
+  EXPECT_NEAR(roof->length, 100.0, 1e-9);
+  EXPECT_EQ(roof->votes, 1);
+  EXPECT_FALSE(memory.vouch({}, 100.0).has_value());
+}
+
 TEST(LayerRatioMemory, ARatioMustHaveHeldLongEnough) {
   LayerRatioMemory memory(kFrames, kSupport, kTolerance);
   rememberRoofOverGround(memory, kSupport - 1);

@@ -32,6 +32,12 @@ class LayerRatioMemory {
   /// newest step has held long enough: a step that broke the ratios silences the memory until
   /// its own ratios have held as long, so that it never fights a new scale it cannot mend.
   std::optional<double> vouchedLength(const std::vector<double>& layer_shifts, double steady) const;
+  /// vouchedLength with the number of ratio-layer pairs that give it.
+  struct Vouched {
+    double length = 0.0;  ///< [px]
+    int votes = 0;
+  };
+  std::optional<Vouched> vouch(const std::vector<double>& layer_shifts, double steady) const;
 
   void clear() { frames_.clear(); }
 
