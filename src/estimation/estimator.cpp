@@ -84,6 +84,15 @@ struct WindowFrame {
   double stamp = 0.0;
 };
 
+// `step` at the length the layers vouched for: its sigma along the step the ratios' tolerance,
+// across it its own, scaled with the length.
+PairMotion atVouchedLength(const PairMotion& step, double vouched) {
+  const double along = alongTrackSigma(step);
+  const double across = std::sqrt(std::max(cv::trace(step.translation_covariance) - along * along, 0.0));
+  return detail::withLength(step, vouched, std::max(kLayerRatioTolerance * vouched, detail::kMinShiftSigma),
+                            std::max(across * vouched / step.shift(), detail::kMinShiftSigma));
+}
+
 }  // namespace
 
 // The window, the previous pair and the per-size machinery; one method per stage of a frame.
@@ -146,10 +155,13 @@ struct Estimator::State {
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
   // A registration too weak to use on its own whose layers in view still vouch (by the ratios
-  // they held) for the length the motion so far predicts: that step (oefmt mode).
+  // they held) for the length the motion so far predicts: that step (oefmt mode), with
+  // est.measured12 and est.vouched_length set.
   std::optional<PairMotion> corroboratedStep(Estimate& est) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
   std::vector<double> layerShifts(const PairRegistration& registration) const;
+  // The length the motion so far predicts for pair 1-2 [px] (needs have01).
+  double steadyLength(const Estimate& est) const { return motion01.shift() * est.frame_gap / gap01; }
   // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
   // registered: even its slowest layer (of those pair 0-1 saw) must stay within
   // kMaxPairShiftFraction of N along both axes.
@@ -644,7 +656,7 @@ std::vector<double> Estimator::State::layerShifts(const PairRegistration& regist
 PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) const {
   const double length = step.shift();
   if (!have01 || !(length > 0.0)) return step;
-  const double steady = motion01.shift() * est.frame_gap / gap01;
+  const double steady = steadyLength(est);
   const std::optional<double> vouched = layer_ratios.vouchedLength(layerShifts(est.registration12), steady);
   if (!vouched || std::fabs(length - *vouched) <= config.tracking.layer_gate * *vouched) return step;
   // The layers mend a step that broke away from the motion so far, and never move one that held
@@ -652,10 +664,7 @@ PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) 
   // jump.
   if (!(std::fabs(*vouched - steady) < std::fabs(length - steady))) return step;
   est.vouched_length = *vouched;
-  const double along = alongTrackSigma(step);
-  const double across = std::sqrt(std::max(cv::trace(step.translation_covariance) - along * along, 0.0));
-  return detail::withLength(step, *vouched, std::max(kLayerRatioTolerance * *vouched, detail::kMinShiftSigma),
-                            std::max(across * *vouched / length, detail::kMinShiftSigma));
+  return atVouchedLength(step, *vouched);
 }
 
 std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) const {
@@ -671,16 +680,13 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
       r.rotation_zoom_implausible || !(r.shift > 0.0)) {
     return std::nullopt;
   }
-  const double steady = motion01.shift() * est.frame_gap / gap01;
+  const double steady = steadyLength(est);
   const std::optional<LayerRatioMemory::Vouched> vouched = layer_ratios.vouch(layerShifts(r), steady);
   if (!vouched || !(std::fabs(vouched->length - steady) <= 2.0 * kLayerRatioTolerance * steady)) return std::nullopt;
   const PairMotion measured = detail::calibrated(r, config.uncertainty);
-  const double along = alongTrackSigma(measured);
-  const double across = std::sqrt(std::max(cv::trace(measured.translation_covariance) - along * along, 0.0));
-  const PairMotion step = detail::withLength(
-      measured, vouched->length, std::max(kLayerRatioTolerance * vouched->length, detail::kMinShiftSigma),
-      std::max(across * vouched->length / r.shift, detail::kMinShiftSigma));
+  const PairMotion step = atVouchedLength(measured, vouched->length);
   if (!(cv::norm(step.translation - prior12->translation) <= prior12->translation_radius)) return std::nullopt;
+  est.measured12 = measured;
   est.vouched_length = vouched->length;
   return step;
 }
@@ -855,20 +861,19 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       }
     }
     est.registration_ms += msSince(t);
-    std::optional<PairMotion> corroborated;
-    if (!est.registration12.usable() && config_.mode == EstimatorMode::kOefmt) corroborated = s.corroboratedStep(est);
-    if (corroborated) {
-      // Pair 0-2 and the loop are left out: they would be weighed against this weak pair.
+    if (!est.registration12.usable()) {
+      // Pair 0-2 and the loop are left out, also for a pair its layers carry: they would be weighed
+      // against a weak pair. (The worker reads `frame`, which moves on below.)
       if (s.pending02.valid()) s.pending02.wait();
       s.pending02 = {};
-      est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
-      est.degraded = true;
-      std::vector<float> next_translation01 = est.registration12.translation_energy;
-      s.advance(std::move(frame), *corroborated, std::move(next_translation01), est);
-    } else if (!est.registration12.usable()) {
-      if (s.pending02.valid()) s.pending02.wait();  // it reads `frame`, which moves on below
-      s.pending02 = {};
-      s.registrationFailed(std::move(frame), textured, est);
+      const std::optional<PairMotion> corroborated =
+          config_.mode == EstimatorMode::kOefmt ? s.corroboratedStep(est) : std::nullopt;
+      if (corroborated) {
+        est.degraded = true;
+        s.advance(std::move(frame), *corroborated, std::vector<float>(est.registration12.translation_energy), est);
+      } else {
+        s.registrationFailed(std::move(frame), textured, est);
+      }
     } else {
       est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
       std::vector<float> next_translation01 = est.registration12.translation_energy;

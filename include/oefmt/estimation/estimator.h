@@ -84,7 +84,8 @@ struct Estimate {
   /// along the step. 0 when they agree.
   double length_spread = 0.0;
   /// The length the layers in view vouched for where the step's own broke their ratios and was
-  /// replaced by it [px]; 0 = the step's own length stood.
+  /// replaced by it, or where pair 1-2 was too weak to register on its own and was tracked on it
+  /// (degraded) [px]; 0 = the step's own length stood.
   double vouched_length = 0.0;
   /// Levelled frames (setLevelled), oefmt mode: the tilt of the ground plane left in the level
   /// view [rad, the frame's image axes: x right, y down], as the pairs' stretch read it, for
