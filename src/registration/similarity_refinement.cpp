@@ -133,18 +133,100 @@ double tukeyLoss(const std::vector<float>& magnitudes, double sigma) {
   return sum / magnitudes.size();
 }
 
-// Robust sigma (robustScale) over every `stride`-th pixel inside both
-// frames; negative when too few are.
+// The image is cut into kLayerBlocks x kLayerBlocks blocks for the depth layers' test: at
+// N = 512 and the refinement's stride, about 50 pixels of the grid each, enough to tell one shift
+// from another where a pixel alone cannot (weak texture under sensor noise).
+constexpr int kLayerBlocks = 8;
+// A block leaves the refinement when another layer's shift fits it better by this many standard
+// errors of the mean difference of the squared residuals (a paired test over its pixels). A
+// periodic texture's alias fits as well as the true shift and removes nothing.
+constexpr double kLayerEvidence = 3.0;
+// Pixels a block needs for the test.
+constexpr int kLayerBlockPixels = 10;
+
+// Which blocks of the newer frame the refinement reads.
+class BlockMask {
+ public:
+  explicit BlockMask(int n) : n_(n), kept_(kLayerBlocks * kLayerBlocks, 1) {}
+  int index(int x, int y) const { return (y * kLayerBlocks / n_) * kLayerBlocks + x * kLayerBlocks / n_; }
+  bool kept(int x, int y) const { return kept_[index(x, y)] != 0; }
+  void drop(int block) { kept_[block] = 0; }
+  int dropped() const { return static_cast<int>(std::count(kept_.begin(), kept_.end(), 0)); }
+
+ private:
+  int n_;
+  std::vector<unsigned char> kept_;
+};
+
+// The blocks where the start's shift explains the frames no worse than the shift of any other
+// depth layer in `other_layers` (at the start's rotation and zoom): over several depths the
+// refinement must measure the followed layer's motion, and where the texture is weak against the
+// noise, Tukey's biweight cannot tell a pixel of another layer from a noisy one, so those layers
+// pull the zoom towards their own.
+BlockMask followedLayerBlocks(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+                              const ImageSimilarity& start, const std::vector<cv::Point2d>& other_layers,
+                              double bias, int stride) {
+  const int n = newer.rows;
+  BlockMask blocks(n);
+  if (other_layers.empty()) return blocks;
+  const InverseMap followed(start, n);
+  std::vector<InverseMap> others;
+  for (const cv::Point2d& shift : other_layers) {
+    ImageSimilarity other = start;
+    other.translation = shift;
+    others.emplace_back(other, n);
+  }
+  // Per block and other layer: sums of d = r_followed^2 - r_other^2, of d^2, and the count.
+  struct Sums {
+    double d = 0.0, d2 = 0.0;
+    int count = 0;
+  };
+  std::vector<Sums> sums(static_cast<std::size_t>(kLayerBlocks * kLayerBlocks) * others.size());
+  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
+    if (!(taper[y] > 0.0f)) continue;
+    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
+      if (!(taper[x] > 0.0f)) continue;
+      const PixelResidual own = residualAt(older, newer, followed, 1.0, bias, x, y);
+      if (!own.inside) continue;
+      const std::size_t block = static_cast<std::size_t>(blocks.index(x, y));
+      for (std::size_t i = 0; i < others.size(); ++i) {
+        const PixelResidual other = residualAt(older, newer, others[i], 1.0, bias, x, y);
+        if (!other.inside) continue;
+        const double d = own.r * own.r - other.r * other.r;
+        Sums& s = sums[block * others.size() + i];
+        s.d += d;
+        s.d2 += d * d;
+        ++s.count;
+      }
+    }
+  }
+  for (int block = 0; block < kLayerBlocks * kLayerBlocks; ++block) {
+    for (std::size_t i = 0; i < others.size(); ++i) {
+      const Sums& s = sums[static_cast<std::size_t>(block) * others.size() + i];
+      if (s.count < kLayerBlockPixels) continue;
+      const double mean = s.d / s.count;
+      const double variance = std::max(s.d2 / s.count - mean * mean, 0.0);
+      if (mean > kLayerEvidence * std::sqrt(variance / s.count)) {
+        blocks.drop(block);
+        break;
+      }
+    }
+  }
+  return blocks;
+}
+
+// Robust sigma (robustScale) over every `stride`-th pixel inside both frames and in a kept
+// block; negative when too few are.
 double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
-                   const ImageSimilarity& motion, double gain, double bias, int stride,
-                   std::vector<float>& scratch, int* count) {
+                   const BlockMask& blocks, const ImageSimilarity& motion, double gain, double bias,
+                   int stride, std::vector<float>& scratch, int* count) {
   const int n = newer.rows;
   const InverseMap map(motion, n);
   scratch.clear();
   for (int y = stride / 2 + 1; y < n - 1; y += stride) {
     if (!(taper[y] > 0.0f)) continue;
     for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-      if (!(taper[x] > 0.0f)) continue;
+      if (!(taper[x] > 0.0f) || !blocks.kept(x, y)) continue;
       const PixelResidual p = residualAt(older, newer, map, gain, bias, x, y);
       if (p.inside) scratch.push_back(static_cast<float>(std::fabs(p.r)));
     }
@@ -217,7 +299,8 @@ RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance
 
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
-                                      int iterations, int stride, bool fit_stretch) {
+                                      int iterations, int stride, bool fit_stretch,
+                                      const std::vector<cv::Point2d>& other_layers) {
   const int n = newer.smooth.rows;
   if (older.empty() || newer.empty() || older.smooth.size() != newer.smooth.size() ||
       static_cast<int>(taper.size()) != n || newer.smooth.cols != n || stride < 1) {
@@ -231,10 +314,14 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   // The exposure's offset on the steps' grid: on the sparser one its estimate is noisy enough to
   // move the first step's robust weights on frames without any.
   double bias = exposureOffset(older.smooth, newer.smooth, taper, start, stride, scratch);
+  // The blocks are chosen at the start: after a step, which fits the layers' compromise, the other
+  // layers' shifts fit the blocks less well than the start's did.
+  const BlockMask blocks = followedLayerBlocks(older.smooth, newer.smooth, taper, start, other_layers, bias, stride);
+  out.dropped_blocks = blocks.dropped();
   // The residuals' scale before and after, on a sparser grid (the start's only sets the first
   // step's robust weights).
   const int sparse = 2 * stride;
-  double sigma = robustSigma(older.smooth, newer.smooth, taper, start, gain, bias, sparse, scratch, nullptr);
+  double sigma = robustSigma(older.smooth, newer.smooth, taper, blocks, start, gain, bias, sparse, scratch, nullptr);
   if (!(sigma > 0.0)) return out;
   out.residual_start = sigma;
   const double sigma_start = sigma;
@@ -252,7 +339,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       if (!(wy > 0.0f)) continue;
       for (int x = stride / 2 + 1; x < n - 1; x += stride) {
         const float w_taper = wy * taper[x];
-        if (!(w_taper > 0.0f)) continue;
+        if (!(w_taper > 0.0f) || !blocks.kept(x, y)) continue;
         const PixelResidual p = residualAt(older.smooth, newer.smooth, map, gain, bias, x, y);
         if (!p.inside) continue;
         scratch.push_back(static_cast<float>(std::fabs(p.r)));
@@ -314,7 +401,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     out.converged = std::fabs(step[0]) < kAngleTolerance && std::fabs(step[1]) < kAngleTolerance &&
                     std::fabs(step[2]) < kShiftTolerance && std::fabs(step[3]) < kShiftTolerance;
   }
-  out.residual_end = robustSigma(older.smooth, newer.smooth, taper, current, gain, bias, sparse, scratch, &out.pixels);
+  out.residual_end = robustSigma(older.smooth, newer.smooth, taper, blocks, current, gain, bias, sparse, scratch, &out.pixels);
   out.similarity = current;
   if (out.residual_end >= 0.0) out.loss_end = tukeyLoss(scratch, sigma_start);
   return out;

@@ -49,6 +49,8 @@ struct SimilarityRefinement {
   /// equations and the residuals' robust sigma (0: no step was solved). It describes the pixels'
   /// noise, not a model that does not fit (several depth layers): calibrate before use.
   double rotation_sigma = 0.0;
+  /// Blocks of the image (of 64) left out because another depth layer's shift fits them better.
+  int dropped_blocks = 0;
 };
 
 /// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see, weighted by
@@ -58,9 +60,15 @@ struct SimilarityRefinement {
 /// `stride`-th row takes part in the `iterations` steps. The bias starts at the frames' mean
 /// difference over those pixels (an exposure change), and where the frames' noise variances are
 /// known the gradients' noise is taken out of the normal equations, which it would otherwise
-/// inflate, shortening every step.
+/// inflate, shortening every step. `other_layers` are the shifts [px] of the pair's other depth
+/// layers (the translation energy vector's other peaks): before the steps, every block of the
+/// image (8 x 8) that one of them explains better than the start's shift, by three standard
+/// errors of the mean difference of the squared residuals over the block's pixels, is left out,
+/// so that the steps measure the followed layer's motion also where the texture is too weak
+/// against the noise for the biweight to tell another layer's pixels from noisy ones.
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
-                                      int iterations, int stride, bool fit_stretch = false);
+                                      int iterations, int stride, bool fit_stretch = false,
+                                      const std::vector<cv::Point2d>& other_layers = {});
 
 }  // namespace oefmt
