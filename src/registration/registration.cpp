@@ -96,11 +96,25 @@ constexpr double kRefinementPixels = 3000.0;
 // A refinement that moves the rotation or the zoom by more than this many bins of the log-polar
 // surface did not start within its reach (another layer, a repetitive pattern): not taken.
 constexpr double kRefinementMaxBins = 2.0;
-// The other depth layers the refinement tests its blocks against: the strongest local maxima of
-// the translation energy vector further than a few pixels from the followed shift. However weak,
-// a peak costs only time: a shift that no block follows fits none better than the followed one.
+// otherLayerShifts: how many peaks, and how near the followed shift a peak is the same layer.
 constexpr int kOtherLayers = 4;
 constexpr double kSameLayerPx = 3.0;
+
+}  // namespace
+
+std::vector<cv::Point2d> otherLayerShifts(const PairRegistration& registration, double shift_per_bin) {
+  std::vector<cv::Point2d> shifts;
+  const cv::Point2d along(std::cos(registration.direction), std::sin(registration.direction));
+  for (const EnergyPeak& peak : energyPeaks(registration.translation_energy, 0.0)) {
+    const double shift = peak.bin * shift_per_bin;
+    if (std::fabs(shift - registration.shift) <= kSameLayerPx) continue;
+    shifts.push_back(along * shift);
+    if (static_cast<int>(shifts.size()) == kOtherLayers) break;
+  }
+  return shifts;
+}
+
+namespace {
 
 // The log-polar surface reads a sub-bin zoom (and rotation) towards the nearest bin: at most
 // radii its samples are as coarse as the grain of the magnitude spectrum, so a fraction of a bin
@@ -119,19 +133,10 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   start.log_zoom = std::log(result.zoom);
   start.translation = result.translation;
   const int stride = std::max(1, static_cast<int>(std::lround(n / std::sqrt(kRefinementPixels))));
-  // The other depth layers of the pair: the translation energy vector's peaks along the
-  // followed shift's direction.
-  std::vector<cv::Point2d> other_layers;
-  const cv::Point2d along(std::cos(result.direction), std::sin(result.direction));
-  for (const EnergyPeak& peak : energyPeaks(result.translation_energy, 0.0)) {
-    const double shift = peak.bin * context.polarRadiusStep();
-    if (std::fabs(shift - result.shift) <= kSameLayerPx) continue;
-    other_layers.push_back(along * shift);
-    if (static_cast<int>(other_layers.size()) == kOtherLayers) break;
-  }
   const SimilarityRefinement refined = refineSimilarity(older.refinement, newer.refinement, start,
                                                         context.window().taper(), kRefinementIterations, stride,
-                                                        /*fit_stretch=*/plane_tilt.has_value(), other_layers);
+                                                        /*fit_stretch=*/plane_tilt.has_value(),
+                                                        otherLayerShifts(result, context.polarRadiusStep()));
   const double rotation_bins = std::fabs(refined.similarity.rotation - start.rotation) * n / CV_PI;
   const double zoom_bins = std::fabs(refined.similarity.log_zoom - start.log_zoom) / log_zoom_per_bin;
   if (!(refined.loss_end >= 0.0 && refined.loss_end <= refined.loss_start) ||

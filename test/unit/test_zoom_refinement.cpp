@@ -9,7 +9,6 @@
 
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator.h"
-#include "oefmt/registration/pattern_matching.h"
 #include "oefmt/registration/registration.h"
 #include "oefmt/registration/similarity_refinement.h"
 #include "oefmt/registration/window.h"
@@ -278,13 +277,7 @@ TEST(ZoomRefinement, LeavingTheOtherLayersBlocksOutSteadiesAWeakTexturesZoom) {
     FrameSpectra newer = registrar.analyse(frames[k]);
     const PairRegistration r = registrar.registerPair(older, newer, RegistrationMethod::kEnergyVectors);
     if (r.status == RegistrationStatus::kOk) {
-      // The other layers as refineZoom takes them: the energy vector's strongest other peaks.
-      std::vector<cv::Point2d> other_layers;
-      const cv::Point2d along(std::cos(r.direction), std::sin(r.direction));
-      for (const EnergyPeak& peak : energyPeaks(r.translation_energy, 0.0)) {
-        const double shift = peak.bin * registrar.shiftPerBin();
-        if (std::fabs(shift - r.shift) > 3.0 && other_layers.size() < 4) other_layers.push_back(along * shift);
-      }
+      const std::vector<cv::Point2d> other_layers = otherLayerShifts(r, registrar.shiftPerBin());
       ImageSimilarity start;
       start.rotation = r.rotation;
       start.log_zoom = std::log(r.zoom);

@@ -123,6 +123,12 @@ struct RegistrationPrior {
   double translation_sigma = 0.0;
 };
 
+/// The shifts [px] of a registered pair's other depth layers, which the zoom refinement tests its
+/// blocks against: the four strongest local maxima of its translation energy vector further than
+/// 3 px from its shift, along its direction (`shift_per_bin`: Registrar::shiftPerBin()). However
+/// weak, a peak costs only time: a shift that nothing follows fits no block better.
+std::vector<cv::Point2d> otherLayerShifts(const PairRegistration& registration, double shift_per_bin);
+
 /// Correlation surfaces of the last registration, for diagnostics and plots.
 struct RegistrationSurfaces {
   cv::Mat1f rotation_zoom;      ///< rows: rotation, columns: log-zoom (centred)
