@@ -75,14 +75,18 @@ struct InverseMap {
   }
 };
 
+// The older frame at the point the newer frame's pixel (x, y) maps to: its bilinear value and
+// derivatives; false outside it.
+bool olderAt(const cv::Mat1f& older, const InverseMap& map, int x, int y, double& a, double& ax, double& ay) {
+  const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
+  return bilinear(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a, ax, ay);
+}
+
 PixelResidual residualAt(const cv::Mat1f& older, const cv::Mat1f& newer, const InverseMap& map,
                          double gain, double bias, int x, int y) {
   PixelResidual p;
-  const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
   double a = 0.0, ax = 0.0, ay = 0.0;
-  if (!bilinear(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a, ax, ay)) {
-    return p;
-  }
+  if (!olderAt(older, map, x, y, a, ax, ay)) return p;
   const float* row = newer[y];
   // The older frame's gradient at the source point maps to the newer's by M^-T = [i00 i10; i01 i11].
   p.gx = 0.5 * (gain * (map.i00 * ax + map.i10 * ay) + 0.5 * (row[x + 1] - row[x - 1]));
@@ -186,13 +190,15 @@ BlockMask followedLayerBlocks(const cv::Mat1f& older, const cv::Mat1f& newer, co
     if (!(taper[y] > 0.0f)) continue;
     for (int x = stride / 2 + 1; x < n - 1; x += stride) {
       if (!(taper[x] > 0.0f)) continue;
-      const PixelResidual own = residualAt(older, newer, followed, 1.0, bias, x, y);
-      if (!own.inside) continue;
+      // residualAt's residual at gain 1, without its symmetric gradient.
+      double a = 0.0, ax = 0.0, ay = 0.0;
+      if (!olderAt(older, followed, x, y, a, ax, ay)) continue;
+      const double own = newer(y, x) - (a + bias);
       const std::size_t block = static_cast<std::size_t>(blocks.index(x, y));
       for (std::size_t i = 0; i < others.size(); ++i) {
-        const PixelResidual other = residualAt(older, newer, others[i], 1.0, bias, x, y);
-        if (!other.inside) continue;
-        const double d = own.r * own.r - other.r * other.r;
+        if (!olderAt(older, others[i], x, y, a, ax, ay)) continue;
+        const double other = newer(y, x) - (a + bias);
+        const double d = own * own - other * other;
         Sums& s = sums[block * others.size() + i];
         s.d += d;
         s.d2 += d * d;
@@ -274,11 +280,8 @@ double exposureOffset(const cv::Mat1f& older, const cv::Mat1f& newer, const std:
     for (int x = stride / 2 + 1; x < n - 1; x += stride) {
       if (!(taper[x] > 0.0f)) continue;
       // residualAt's difference at gain 1 and bias 0, without its symmetric gradient.
-      const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
       double a = 0.0, ax = 0.0, ay = 0.0;
-      if (bilinear(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a, ax, ay)) {
-        residuals.push_back(static_cast<float>(newer(y, x) - a));
-      }
+      if (olderAt(older, map, x, y, a, ax, ay)) residuals.push_back(static_cast<float>(newer(y, x) - a));
     }
   }
   if (residuals.size() < kSimilarityParameters * 10u) return 0.0;

@@ -103,22 +103,21 @@ TEST(ZoomRefinement, TheRefinementReadsSubBinRotationsToo) {
 
 // Two depth layers, each moved by its own similarity: the followed one (the start's shift) holds
 // `followed_share` of the pixels; the other is shifted 15 px further and zoomed 1.5 bins more
-// (roofs, a frame's step later; in level flight the zooms are the same).
+// (roofs, a frame's step later).
 struct TwoLayerPair {
   cv::Mat1f older, newer;
   sim::ViewMotion followed, other;
 };
 
-TwoLayerPair twoLayerPair(double followed_share, double per_bin, double other_zoom_bins = 1.9,
-                          double roof_px = 40.0) {
+TwoLayerPair twoLayerPair(double followed_share, double per_bin) {
   const cv::Mat1f& ground = test::sceneTexture(8);
   const cv::Mat1f& roofs = test::sceneTexture(9);
   const cv::Point2d centre(ground.cols / 2.0, ground.rows / 2.0);
   // Roof blocks over the ground, a fixed pattern on the texture that moves with the roofs.
-  const cv::Mat1f roof_mask = sim::blockMask(ground.size(), 5, roof_px, 1.0 - followed_share);
+  const cv::Mat1f roof_mask = sim::blockMask(ground.size(), 5, 40.0, 1.0 - followed_share);
   TwoLayerPair pair;
   pair.followed = motionOf(0.4, 0.0, per_bin);
-  pair.other = motionOf(other_zoom_bins, 0.0, per_bin);
+  pair.other = motionOf(1.9, 0.0, per_bin);
   pair.other.shift += cv::Point2d(15.0, 0.0);
   auto view = [&](const sim::ViewMotion& ground_motion, const sim::ViewMotion& roof_motion) {
     const cv::Mat1f g = sim::renderView(ground, centre, ground_motion, kN);
@@ -201,6 +200,18 @@ TEST(ZoomRefinement, AnExposureChangeOnWeakTextureKeepsTheLayersZoom) {
   }
 }
 
+// Weak texture (grey std 10 of 255) under sensor noise of 5 grey levels in both frames.
+void weakAndNoisy(cv::Mat1f& older, cv::Mat1f& newer, unsigned seed) {
+  older = weakTexture(older, 1.0);
+  newer = weakTexture(newer, 1.0);
+  cv::RNG rng(seed);
+  cv::Mat1f noise(older.size());
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 5.0 / 255.0);
+  older += noise;
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, 5.0 / 255.0);
+  newer += noise;
+}
+
 TEST(ZoomRefinement, KnownSensorNoiseDoesNotShortenTheSteps) {
   // Weak texture under sensor noise of half its contrast: the gradients' noise inflates the
   // normal equations and each step falls short of the zoom by a fraction. With the frames' noise
@@ -213,13 +224,8 @@ TEST(ZoomRefinement, KnownSensorNoiseDoesNotShortenTheSteps) {
   double worst_known = 0.0, worst_unknown = 0.0;
   for (unsigned seed : {11u, 12u, 13u}) {
     test::ImagePair pair = test::warpedPair(motion, kN, seed);
-    cv::Mat1f older = weakTexture(pair.older, 1.0), newer = weakTexture(pair.newer, 1.0);
-    cv::RNG rng(seed);
-    cv::Mat1f noise_older(older.size()), noise_newer(newer.size());
-    rng.fill(noise_older, cv::RNG::NORMAL, 0.0, noise);
-    rng.fill(noise_newer, cv::RNG::NORMAL, 0.0, noise);
-    older += noise_older;
-    newer += noise_newer;
+    cv::Mat1f older = pair.older, newer = pair.newer;
+    weakAndNoisy(older, newer, seed);
     ImageSimilarity start;
     start.translation = motion.shift;
     start.log_zoom = std::log(motion.zoom) - 0.5 * per_bin;
@@ -234,18 +240,6 @@ TEST(ZoomRefinement, KnownSensorNoiseDoesNotShortenTheSteps) {
   }
   EXPECT_LT(worst_known, 0.05);
   EXPECT_GT(worst_unknown, 2.0 * worst_known);  // the premise
-}
-
-// Weak texture (grey std 10 of 255) under sensor noise of 5 grey levels in both frames.
-void weakAndNoisy(cv::Mat1f& older, cv::Mat1f& newer, unsigned seed) {
-  older = weakTexture(older, 1.0);
-  newer = weakTexture(newer, 1.0);
-  cv::RNG rng(seed);
-  cv::Mat1f noise(older.size());
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, 5.0 / 255.0);
-  older += noise;
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, 5.0 / 255.0);
-  newer += noise;
 }
 
 TEST(ZoomRefinement, LeavingTheOtherLayersBlocksOutSteadiesAWeakTexturesZoom) {
@@ -270,6 +264,9 @@ TEST(ZoomRefinement, LeavingTheOtherLayersBlocksOutSteadiesAWeakTexturesZoom) {
   Registrar registrar(config);
   const double per_bin = registrar.logZoomPerBin();
   const int stride = static_cast<int>(std::lround(kN / std::sqrt(3000.0)));
+  const SeparableWindow window(kN, config.taper_fraction);
+  const std::vector<float>& taper = window.taper();
+  const double variance = options.sensor.noise * options.sensor.noise;
   double square_with = 0.0, square_without = 0.0;
   int pairs = 0, dropped = 0;
   FrameSpectra older = registrar.analyse(frames[0]);
@@ -282,9 +279,6 @@ TEST(ZoomRefinement, LeavingTheOtherLayersBlocksOutSteadiesAWeakTexturesZoom) {
       start.rotation = r.rotation;
       start.log_zoom = std::log(r.zoom);
       start.translation = r.translation;
-      const SeparableWindow window(kN, config.taper_fraction);
-      const std::vector<float>& taper = window.taper();
-      const double variance = options.sensor.noise * options.sensor.noise;
       const RefinementImage a = makeRefinementImage(older.grey, variance);
       const RefinementImage b = makeRefinementImage(newer.grey, variance);
       const SimilarityRefinement with = refineSimilarity(a, b, start, taper, 2, stride, false, other_layers);
