@@ -19,4 +19,8 @@ double logZoomOfTilt(const cv::Point2d& tilt, const cv::Point2d& translation) {
   return 1.5 * tilt.dot(translation);
 }
 
+double logZoomOfSlope(double stretch_a, double stretch_b, const cv::Point2d& translation) {
+  return 0.5 * tiltFromStretch(stretch_a, stretch_b, translation).dot(translation);
+}
+
 }  // namespace oefmt

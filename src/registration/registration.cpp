@@ -86,12 +86,14 @@ EnergyVectorOptions energyVectorOptions(const RegistrationConfig& config) {
   return options;
 }
 
-// Gauss-Newton steps of the zoom refinement (it starts within a bin: the first step lands close,
-// the second reweighs the pixels), and the pixels that take part: about 3 000 on a regular grid
-// pin four parameters and a photometric gain and bias far below a bin at any size. Not more
-// steps: over several depth layers they go on towards one similarity's compromise of all the
-// layers, away from the followed layer's zoom (doc/method.md).
-constexpr int kRefinementIterations = 2;
+// Gauss-Newton steps of the zoom refinement, and the pixels that take part: about 3 000 on a
+// regular grid pin four parameters, a stretch and a photometric gain and bias far below a bin at
+// any size. The rotation and zoom start within a bin and land close in one step; the stretch
+// starts at zero and needs more: after two steps it is read at about half its size (the pairs'
+// zoom errors then follow their stretch at twice the slope plane_tilt.h derives), after four
+// whole. Not many more: over several depth layers they go on towards one similarity's compromise
+// of all the layers, away from the followed layer's zoom (doc/method.md).
+constexpr int kRefinementIterations = 4;
 constexpr double kRefinementPixels = 3000.0;
 // A refinement that moves the rotation or the zoom by more than this many bins of the log-polar
 // surface did not start within its reach (another layer, a repetitive pattern): not taken.
@@ -116,6 +118,17 @@ std::vector<cv::Point2d> otherLayerShifts(const PairRegistration& registration, 
 
 namespace {
 
+// The slope correction of a level camera's zoom (logZoomOfSlope), taken only as far as it brings
+// the zoom back towards what the motion so far predicts: a slope under the motion explains a
+// zoom that broke away from the prediction. Where a stretch would move the zoom away from it,
+// or past it, the stretch is not a slope's (occlusions at walls, a mixture of layers that the
+// affine model does not describe, noise): over strong parallax the pairs' zoom errors do not
+// follow their stretch. Without a prediction nothing is corrected.
+double slopeTowardsPrediction(double correction, double to_prediction) {
+  if (!(correction * to_prediction > 0.0)) return 0.0;
+  return correction > 0.0 ? std::min(correction, to_prediction) : std::max(correction, to_prediction);
+}
+
 // The log-polar surface reads a sub-bin zoom (and rotation) towards the nearest bin: at most
 // radii its samples are as coarse as the grain of the magnitude spectrum, so a fraction of a bin
 // does not move them as a whole. The intensities of both frames tell the rest (doc/method.md).
@@ -125,7 +138,7 @@ namespace {
 // beside the surface's, and the estimator weighs the two (doc/method.md).
 void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const SpectralContext& context,
                 double log_zoom_per_bin, const std::optional<cv::Point2d>& plane_tilt,
-                PairRegistration& result) {
+                const RegistrationPrior* prior, PairRegistration& result) {
   if (older.refinement.empty() || newer.refinement.empty()) return;
   const int n = context.size();
   ImageSimilarity start;
@@ -135,7 +148,7 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   const int stride = std::max(1, static_cast<int>(std::lround(n / std::sqrt(kRefinementPixels))));
   const SimilarityRefinement refined = refineSimilarity(older.refinement, newer.refinement, start,
                                                         context.window().taper(), kRefinementIterations, stride,
-                                                        /*fit_stretch=*/plane_tilt.has_value(),
+                                                        /*fit_stretch=*/true,
                                                         otherLayerShifts(result, context.polarRadiusStep()));
   const double rotation_bins = std::fabs(refined.similarity.rotation - start.rotation) * n / CV_PI;
   const double zoom_bins = std::fabs(refined.similarity.log_zoom - start.log_zoom) / log_zoom_per_bin;
@@ -144,7 +157,15 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
       !(zoom_bins <= kRefinementMaxBins)) {
     return;
   }
-  result.tilt_log_zoom = plane_tilt ? logZoomOfTilt(*plane_tilt, refined.similarity.translation) : 0.0;
+  // A levelled view's stretch is mostly its attitude source's error (a tilt of the whole view,
+  // tracked over many pairs); a level camera's, the slope of the surface under this pair.
+  if (plane_tilt) {
+    result.tilt_log_zoom = logZoomOfTilt(*plane_tilt, refined.similarity.translation);
+  } else if (prior != nullptr) {
+    result.tilt_log_zoom = slopeTowardsPrediction(
+        logZoomOfSlope(refined.similarity.stretch_a, refined.similarity.stretch_b, refined.similarity.translation),
+        prior->log_zoom - refined.similarity.log_zoom);
+  }
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
   if (!plane_tilt) {
@@ -334,7 +355,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
   if (result.status == RegistrationStatus::kOk && context_->config().refine_zoom) {
-    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, result);
+    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, prior, result);
   }
 }
 

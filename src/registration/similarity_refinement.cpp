@@ -290,6 +290,52 @@ double exposureOffset(const cv::Mat1f& older, const cv::Mat1f& newer, const std:
   return sum / static_cast<double>(residuals.size());
 }
 
+// One pixel's share of the normal equations of the first P parameters (a fixed count, so that
+// the products unroll): its Jacobian j, weight w and residual r.
+template <int P>
+void accumulate(const Vector& j, double w, double r, Normal& normal, Vector& rhs) {
+  for (int a = 0; a < P; ++a) {
+    const double wj = w * j[a];
+    rhs[a] += wj * r;
+    for (int b = a; b < P; ++b) normal(a, b) += wj * j[b];
+  }
+}
+
+// The gradients' noise adds var (U U^T + V V^T) to each pixel's expected normal matrix, with
+// j_geometric = -(g_x U + g_y V); without its removal every step falls short. U and V are linear
+// in the pixel's position (px, py) from the warp's centre, so the pixels' sum needs only the
+// weighted moments of (1, px, py), gathered once per step.
+class PositionMoments {
+ public:
+  void add(double w, double px, double py) {
+    const double phi[3] = {1.0, px, py};
+    for (int a = 0; a < 3; ++a) {
+      for (int b = a; b < 3; ++b) m_(a, b) += w * phi[a] * phi[b];
+    }
+  }
+
+  // normal(a, b) -= variance * sum_pixels w (U_a U_b + V_a V_b), a <= b < parameters.
+  void subtractNoise(double variance, int parameters, Normal& normal) const {
+    cv::Matx33d m = m_;
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < a; ++b) m(a, b) = m(b, a);
+    }
+    // U and V of each parameter as coefficients of (1, px, py):
+    // U = (py, px, 1, 0, 0, 0, px, py), V = (-px, py, 0, 1, 0, 0, -py, px).
+    static const cv::Vec3d kU[kParameters] = {{0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, 0},
+                                              {0, 0, 0}, {0, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    static const cv::Vec3d kV[kParameters] = {{0, -1, 0}, {0, 0, 1}, {0, 0, 0}, {1, 0, 0},
+                                              {0, 0, 0}, {0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    for (int a = 0; a < parameters; ++a) {
+      const cv::Vec3d mu = m * kU[a], mv = m * kV[a];
+      for (int b = a; b < parameters; ++b) normal(a, b) -= variance * (mu.dot(kU[b]) + mv.dot(kV[b]));
+    }
+  }
+
+ private:
+  cv::Matx33d m_ = cv::Matx33d::zeros();
+};
+
 }  // namespace
 
 RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance) {
@@ -335,6 +381,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     const InverseMap map(current, n);
     Normal normal = Normal::zeros();
     Vector rhs = Vector::all(0.0);
+    PositionMoments moments;
     const double limit = kTukey * sigma;
     scratch.clear();
     for (int y = stride / 2 + 1; y < n - 1; y += stride) {
@@ -361,23 +408,15 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
         j[5] = 1.0;
         j[6] = -(p.gx * px - p.gy * py);  // stretch a: (px, -py)
         j[7] = -(p.gx * py + p.gy * px);  // stretch b: (py, px)
-        for (int a = 0; a < parameters; ++a) {
-          const double wj = w * j[a];
-          rhs[a] += wj * p.r;
-          for (int b = a; b < parameters; ++b) normal(a, b) += wj * j[b];
+        if (fit_stretch) {
+          accumulate<kParameters>(j, w, p.r, normal, rhs);
+        } else {
+          accumulate<kSimilarityParameters>(j, w, p.r, normal, rhs);
         }
-        if (gradient_noise > 0.0) {
-          // The gradients' noise adds var (U U^T + V V^T) to the expected normal matrix, with
-          // j_geometric = -(g_x U + g_y V); without its removal every step falls short.
-          const double u[kParameters] = {py, px, 1.0, 0.0, 0.0, 0.0, px, py};
-          const double v[kParameters] = {-px, py, 0.0, 1.0, 0.0, 0.0, -py, px};
-          const double wn = w * gradient_noise;
-          for (int a = 0; a < parameters; ++a) {
-            for (int b = a; b < parameters; ++b) normal(a, b) -= wn * (u[a] * u[b] + v[a] * v[b]);
-          }
-        }
+        if (gradient_noise > 0.0) moments.add(w, px, py);
       }
     }
+    if (gradient_noise > 0.0) moments.subtractNoise(gradient_noise, parameters, normal);
     // The next step's scale: this pass's residuals (before its step).
     const double next = robustScale(scratch);
     if (!(next > 0.0)) return out;

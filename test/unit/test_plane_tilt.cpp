@@ -14,6 +14,7 @@
 #include "oefmt/estimation/plane_tilt_tracker.h"
 #include "oefmt/registration/plane_tilt.h"
 #include "oefmt/registration/registration.h"
+#include "oefmt/sim/camera_model.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
 #include "support/fixtures.h"
@@ -92,13 +93,88 @@ TEST(PlaneTilt, ALevelledViewOffByTheAttitudeErrorGetsItsZoomBack) {
     if (error > 0.0) {
       EXPECT_GT(std::fabs(std::log(plain.zoom)), 0.004);
     }
-    // Without a plane tilt set, a similarity is refined: no stretch.
+    // Without a plane tilt set (a level camera) the same stretch is fitted; without a prediction
+    // of the zoom nothing is corrected (ALevelFlightOverASlopeReadsNoClimb has one).
     registrar.setPlaneTilt(std::nullopt);
-    const PairRegistration similarity = registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors);
-    EXPECT_EQ(similarity.stretch_a, 0.0);
-    EXPECT_EQ(similarity.stretch_b, 0.0);
-    EXPECT_EQ(similarity.tilt_log_zoom, 0.0);
+    const PairRegistration level = registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors);
+    ASSERT_TRUE(level.zoom_refined) << error;
+    EXPECT_DOUBLE_EQ(level.stretch_a, plain.stretch_a) << error;
+    EXPECT_DOUBLE_EQ(level.stretch_b, plain.stretch_b) << error;
+    EXPECT_EQ(level.tilt_log_zoom, 0.0) << error;
+    EXPECT_DOUBLE_EQ(level.zoom, plain.zoom) << error;
   }
+}
+
+TEST(PlaneTilt, TheSlopeCorrectionIsMinusTheStretchAlongTheMotion) {
+  for (const cv::Point2d d : {cv::Point2d(80.0, 30.0), cv::Point2d(-12.0, 55.0), cv::Point2d(0.0, -40.0)}) {
+    for (const cv::Point2d tilt : {cv::Point2d(3e-5, -2e-5), cv::Point2d(-1e-4, 0.0), cv::Point2d(0.0, 5e-5)}) {
+      const auto [a, b] = stretchOf(tilt, d);
+      const cv::Point2d u = d / cv::norm(d);
+      const double along = a * (u.x * u.x - u.y * u.y) + 2.0 * b * u.x * u.y;  // u^T S u
+      EXPECT_NEAR(logZoomOfSlope(a, b, d), -along, 1e-15) << d << tilt;
+      EXPECT_NEAR(logZoomOfSlope(a, b, d), 0.5 * tilt.dot(d), 1e-15) << d << tilt;
+    }
+  }
+  EXPECT_EQ(logZoomOfSlope(0.01, 0.02, cv::Point2d(0.0, 0.0)), 0.0);
+}
+
+// A camera pitched and rolled by 3 degrees that moves parallel to its image plane over flat
+// ground sees exactly what a level camera flying level over a surface that slopes by 3.35
+// degrees sees: the ground's distance changes under the motion, the camera's along its axis does
+// not. The pair's read zoom holds half the slope's rise (about 0.6 % here). With the motion so far
+// predicting no climb, the stretch along the motion takes it out; a prediction on the other side
+// of the read zoom, or none, leaves the zoom as read, and one short of the truth stops it there.
+TEST(PlaneTilt, ALevelFlightOverASlopeReadsNoClimb) {
+  const sim::FlightPlan plan = flatLine(2, 5);
+  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
+  const sim::Renderer renderer(scene, plan.camera, 2);
+  RegistrationConfig config;
+  config.size = kN;
+  config.fft_planning = FftPlanning::kEstimate;
+  Registrar registrar(config);
+  sim::FlightPose older = plan.poses[0], newer = plan.poses[1];
+  older.pitch = newer.pitch = 3.0 * kDeg;
+  older.roll = newer.roll = -1.5 * kDeg;
+  // The optical axis in the world: the motion is made perpendicular to it by a climb or descent.
+  const cv::Matx33d rotation = sim::opticalToWorld(older);
+  const cv::Vec3d axis(rotation(0, 2), rotation(1, 2), rotation(2, 2));
+  cv::Vec3d motion = newer.position - older.position;
+  motion[2] = -(axis[0] * motion[0] + axis[1] * motion[1]) / axis[2];
+  newer.position = older.position + motion;
+  ASSERT_GT(std::fabs(motion[2]), 0.1);
+  const FrameSpectra a = registrar.analyse(renderer.render(older).image);
+  const FrameSpectra b = registrar.analyse(renderer.render(newer).image);
+  const auto registered = [&](std::optional<double> predicted_log_zoom) {
+    if (!predicted_log_zoom) return registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors);
+    RegistrationPrior prior;
+    prior.log_zoom = *predicted_log_zoom;
+    prior.rotation_window = 0.1;
+    prior.log_zoom_window = 0.05;
+    return registrar.registerPair(a, b, RegistrationMethod::kEnergyVectors, nullptr, &prior);
+  };
+  const PairRegistration unpredicted = registered(std::nullopt);
+  ASSERT_TRUE(unpredicted.zoom_refined);
+  const double read = std::log(unpredicted.zoom);
+  EXPECT_EQ(unpredicted.tilt_log_zoom, 0.0);
+  EXPECT_GT(std::fabs(read), 0.004);
+  // The slope the stretch reads: 3.35 degrees over the focal length.
+  const cv::Point2d tilt = tiltFromStretch(unpredicted.stretch_a, unpredicted.stretch_b, unpredicted.translation);
+  const double slope = std::tan(std::hypot(3.0, 1.5) * kDeg) / plan.camera.intrinsics.fx;
+  EXPECT_NEAR(cv::norm(tilt), slope, 0.1 * slope);
+
+  const PairRegistration predicted = registered(0.0);
+  ASSERT_TRUE(predicted.zoom_refined);
+  EXPECT_NEAR(std::log(predicted.zoom), 0.0, 0.0012);
+  EXPECT_GT(std::fabs(predicted.tilt_log_zoom), 0.004);
+
+  const PairRegistration beyond = registered(2.0 * read);  // the prediction on the read zoom's side
+  ASSERT_TRUE(beyond.zoom_refined);
+  EXPECT_EQ(beyond.tilt_log_zoom, 0.0);
+  EXPECT_DOUBLE_EQ(beyond.zoom, unpredicted.zoom);
+
+  const PairRegistration short_of_truth = registered(0.5 * read);
+  ASSERT_TRUE(short_of_truth.zoom_refined);
+  EXPECT_NEAR(std::log(short_of_truth.zoom), 0.5 * read, 1e-12);
 }
 
 // A straight flight over flat ground whose levelled views are off by 1.5 degrees throughout (an

@@ -7,9 +7,11 @@
 // (1 + t_z/d) I - u v^T with u = t_xy/d and v = n_xy: besides the zoom of the motion along the
 // view, a rank-one term whose isotropic part (-u.v/2) the registration reads as zoom, and whose
 // stretch along the motion (-|u| v_u / 2) tells the tilt. The distance along the view to the plane
-// changes by n.t, so the zoom that carries the altitude is t_z/d + u.v: the read zoom plus 1.5 u.v.
-// A level camera over a slope and a levelled view off by an attitude error δ are the same case (a
-// tilt δ): flying L, the read zoom is off by 1.5 δ L / d, a climb or descent that is not there.
+// changes by n.t. In a levelled view off by an attitude error δ the ground is level and the view
+// tilted: the altitude changes by n.t, the zoom that carries it is t_z/d + u.v, the read zoom plus
+// 1.5 u.v, and flying L the read zoom is off by 1.5 δ L / d, a climb or descent that is not there.
+// A level camera over a sloping surface sees the same images, but there t_z is the climb and n.t
+// the surface's rise: the zoom that carries the altitude is the read zoom plus u.v / 2.
 //
 // In pixels the tilt is v / f [1/px]: a pair that moved by d [px] is stretched along d by
 // -(tilt . d) / 2 (the stretch of S = [a b; b -a] along a unit vector w is w^T S w), and its read
@@ -27,5 +29,15 @@ cv::Point2d tiltFromStretch(double stretch_a, double stretch_b, const cv::Point2
 /// The change of ln(zoom) that a tilt [1/px] makes the registration miss on a pair that moved by
 /// `translation` [px]: add it to the read ln(zoom).
 double logZoomOfTilt(const cv::Point2d& tilt, const cv::Point2d& translation);
+
+/// A level camera over a surface that slopes: the ln(zoom) to add to a pair's read zoom so that
+/// it carries the camera's climb (t_z / d) and not the surface's rise under the motion. The read
+/// zoom holds -u.v / 2, the isotropic part of the rank-one term, and the pair's stretch along its
+/// motion the same -u.v / 2: the correction is minus that stretch, (tilt . d) / 2 with the tilt
+/// the stretch reads (tiltFromStretch). Any depth structure under a translation bends the flow by
+/// a term of that form (the flow is the translation times the inverse depth), so a surface's
+/// slope, a layer's edge or a mixture of layers in the fitted pixels are corrected alike; a
+/// climb and a turn stretch nothing.
+double logZoomOfSlope(double stretch_a, double stretch_b, const cv::Point2d& translation);
 
 }  // namespace oefmt

@@ -80,7 +80,8 @@ struct PairRegistration {
   double refined_rotation_sigma = 0.0;
   double stretch_a = 0.0;
   double stretch_b = 0.0;
-  /// ln(zoom) added for the ground plane's tilt (Registrar::setPlaneTilt), included in `zoom`.
+  /// ln(zoom) added for the ground plane's tilt or the followed surface's slope
+  /// (Registrar::setPlaneTilt), included in `zoom`.
   double tilt_log_zoom = 0.0;
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
@@ -171,9 +172,10 @@ class Registrar {
   void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
   /// Frames levelled by an attitude source: the ground plane's tilt left in the level view
   /// [1/px, image axes] (the source's error), for which the refined zooms are corrected
-  /// (oefmt/registration/plane_tilt.h); the refinement then also fits each pair's stretch, the
-  /// reading of that tilt (PairRegistration::stretch_a, stretch_b). nullopt (the default): a
-  /// similarity is refined and nothing corrected.
+  /// (oefmt/registration/plane_tilt.h) from the tilt set, the reading of the pairs' stretch
+  /// (PairRegistration::stretch_a, stretch_b) over many pairs. nullopt (the default): a level
+  /// camera; each pair's own stretch is read as the slope of the surface under it, which corrects
+  /// its zoom as far as it brings it back towards the prior's (none without a prior).
   void setPlaneTilt(const std::optional<cv::Point2d>& tilt) { plane_tilt_ = tilt; }
 
  private:
