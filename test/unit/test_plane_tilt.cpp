@@ -58,18 +58,34 @@ sim::FlightPlan flatLine(int frames, unsigned seed) {
   return sim::planFlight(options);
 }
 
+RegistrationConfig pairConfig() {
+  RegistrationConfig config;
+  config.size = kN;
+  config.fft_planning = FftPlanning::kEstimate;
+  return config;
+}
+
+// Two frames of a straight flight over flat ground (flatLine), their renderer and a registrar
+// of the tests' size.
+struct FlatPairRig {
+  explicit FlatPairRig(unsigned seed)
+      : plan(flatLine(2, seed)),
+        renderer(std::make_shared<const sim::Scene>(plan.scene), plan.camera, 2),
+        registrar(pairConfig()) {}
+  const sim::FlightPlan plan;
+  const sim::Renderer renderer;
+  Registrar registrar;
+};
+
 // Two frames of a flight over flat ground whose camera is pitched and rolled by the same small
 // angle in both (a levelled view whose attitude was off by it): the pair's zoom reads a change of
 // altitude that is not there; the stretch the refinement fits reads the tilt, and the zoom
 // corrected for it is one.
 TEST(PlaneTilt, ALevelledViewOffByTheAttitudeErrorGetsItsZoomBack) {
-  const sim::FlightPlan plan = flatLine(2, 4);
-  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
-  const sim::Renderer renderer(scene, plan.camera, 2);
-  RegistrationConfig config;
-  config.size = kN;
-  config.fft_planning = FftPlanning::kEstimate;
-  Registrar registrar(config);
+  FlatPairRig rig(4);
+  const sim::FlightPlan& plan = rig.plan;
+  const sim::Renderer& renderer = rig.renderer;
+  Registrar& registrar = rig.registrar;
   for (const double error : {0.0, 2.0 * kDeg}) {
     sim::FlightPose older = plan.poses[0], newer = plan.poses[1];
     older.pitch = newer.pitch = error;
@@ -125,13 +141,10 @@ TEST(PlaneTilt, TheSlopeCorrectionIsMinusTheStretchAlongTheMotion) {
 // predicting no climb, the stretch along the motion takes it out; a prediction on the other side
 // of the read zoom, or none, leaves the zoom as read, and one short of the truth stops it there.
 TEST(PlaneTilt, ALevelFlightOverASlopeReadsNoClimb) {
-  const sim::FlightPlan plan = flatLine(2, 5);
-  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
-  const sim::Renderer renderer(scene, plan.camera, 2);
-  RegistrationConfig config;
-  config.size = kN;
-  config.fft_planning = FftPlanning::kEstimate;
-  Registrar registrar(config);
+  FlatPairRig rig(5);
+  const sim::FlightPlan& plan = rig.plan;
+  const sim::Renderer& renderer = rig.renderer;
+  Registrar& registrar = rig.registrar;
   sim::FlightPose older = plan.poses[0], newer = plan.poses[1];
   older.pitch = newer.pitch = 3.0 * kDeg;
   older.roll = newer.roll = -1.5 * kDeg;
