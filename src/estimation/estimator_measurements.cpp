@@ -16,6 +16,9 @@ double finiteOr(double v, double fallback) { return std::isfinite(v) ? v : fallb
 
 // Smallest gate [px] between the followed layer's predicted and measured shift: sub-pixel noise.
 constexpr double kMinLayerGatePx = 1.5;
+// A peak further than this many of the PMT's sigmas from the length the PMT reads is not the
+// layer the PMT read: a normal error stays within three sigmas 99.7 % of the time.
+constexpr double kPmtGateSigmas = 3.0;
 
 // observe() with a predicted translation: which peak is the followed layer's (see the header).
 // Depth layers of one motion lie along one direction at different lengths: the length tells the
@@ -39,10 +42,15 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   // again), but the energy vectors' stretch (PMT) reads the followed layer's own length: where it
   // does so within the gate, a peak further than tracking.layer_gate from that length is another
   // layer or an alias, however wide the gate. Without this one switch between layers widens the
-  // spread of the last steps, and the wider gate lets the next switch through.
+  // spread of the last steps, and the wider gate lets the next switch through. Neighbouring
+  // layers (a sloped roof, tops a few per cent of the altitude apart) lie closer to each other
+  // than layer_gate, while the PMT reads the length to a fraction of a per cent: where its own
+  // sigma says so, the gate around its length narrows to kPmtGateSigmas of them.
   const double pmt_length = pmt.valid ? pmt.value * ref.shift : 0.0;
   const bool pmt_reads_layer = pmt.valid && std::fabs(pmt_length - length) <= gate;
-  const double pmt_gate = std::max(config.tracking.layer_gate * pmt_length, kMinLayerGatePx);
+  const double pmt_sigma = pmt.valid ? std::hypot(pmt_length * pmt.sigma, pmt.value * ref.shift_sigma) : 0.0;
+  const double pmt_gate = std::max(std::min(config.tracking.layer_gate * pmt_length, kPmtGateSigmas * pmt_sigma),
+                                   kMinLayerGatePx);
   const auto followed = [&](const cv::Point2d& d) {
     return alongMotion(d) && std::fabs(cv::norm(d) - length) <= gate &&
            (!pmt_reads_layer || std::fabs(cv::norm(d) - pmt_length) <= pmt_gate);
@@ -83,7 +91,7 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
     along_sigma = alongTrackSigma(layered);
   } else if (pmt_says_other_layer || pmt_reads_layer) {
     along = pmt_length;
-    along_sigma = std::hypot(along * pmt.sigma, pmt.value * ref.shift_sigma);
+    along_sigma = pmt_sigma;
   }
   along_sigma = std::max(along_sigma, kMinShiftSigma);
   obs.shift.push_back({along, along_sigma});

@@ -172,6 +172,39 @@ TEST(ObserveFollowedLayer, APeakThePatternMatchConfirmsStands) {
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kVector);
 }
 
+// A neighbouring layer (a sloped roof, 5 % faster or slower) stands out in the prediction's
+// window, closer to the PMT's reading than tracking.layer_gate. Where the PMT reads the followed
+// layer's length to under a per cent, that peak is many of its sigmas off: the step keeps the
+// followed layer's own peak. Where the PMT is as loose as the layers are close, it cannot tell
+// them apart and the window's peak stands.
+PairMotion observedWithNeighbour(double pmt_sigma) {
+  RegistrationPrior prior;
+  prior.translation = {132.0, 0.0};
+  prior.translation_sigma = 0.5;
+  prior.translation_radius = 40.0;
+  detail::Reference ref;
+  ref.translation = {132.0, 0.0};
+  ref.shift = 132.0;
+  ref.shift_sigma = 0.3;
+  PairRegistration registration = withPeaks({{108.9, 1.0}, {132.0, 0.3}});
+  registration.translation = {108.9, 0.0};
+  registration.followed_translation = {125.9, 0.0};
+  registration.followed_confidence = 1.0;
+  MatchResult pmt;
+  pmt.valid = true;
+  pmt.value = 1.0;
+  pmt.sigma = pmt_sigma;
+  PairMotion initial;
+  detail::observe(registration, motionAlongX(108.9), pmt, MatchResult(), ref, EstimatorConfig(), kShiftPerBin,
+                  1.0, 1.0, &prior, initial);
+  return initial;
+}
+
+TEST(ObserveFollowedLayer, ATightPatternMatchTellsANeighbouringLayer) {
+  EXPECT_NEAR(observedWithNeighbour(0.008).shift(), 132.0, 0.5);
+  EXPECT_NEAR(observedWithNeighbour(0.03).shift(), 125.9, 1e-9);
+}
+
 TEST(LengthSpread, OtherReadingsInsideTheWindowWiden) {
   EXPECT_NEAR(detail::lengthSpread(108.9, {108.9, 131.8}, 0.05, 40.0), 22.9, 1e-9);
   // The largest of several; unbounded without a window.
