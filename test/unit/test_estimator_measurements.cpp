@@ -122,34 +122,44 @@ TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
   EXPECT_DOUBLE_EQ(step.shift(), 12.0);
 }
 
-// A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose
-// highest peak agreed with it: one reading is another layer's, and the spread says by how much.
+// observe() of a pair whose followed layer was predicted (and last moved) 132 px along x, with the
+// PMT reading `stretch` of that length to a relative sigma `pmt_sigma` (stretch 0: no PMT).
+PairMotion observedAfter132(const RegistrationPrior& prior, double shift_sigma,
+                            const PairRegistration& registration, double stretch, double pmt_sigma,
+                            PairObservations* out = nullptr) {
+  detail::Reference ref;
+  ref.translation = {132.0, 0.0};
+  ref.shift = 132.0;
+  ref.shift_sigma = shift_sigma;
+  MatchResult pmt;
+  pmt.valid = stretch > 0.0;
+  pmt.value = stretch;
+  pmt.sigma = pmt_sigma;
+  PairMotion initial;
+  const PairObservations obs =
+      detail::observe(registration, motionAlongX(registration.translation.x), pmt, MatchResult(), ref,
+                      EstimatorConfig(), kShiftPerBin, 1.0, 1.0, &prior, initial);
+  if (out) *out = obs;
+  return initial;
+}
+
+RegistrationPrior predicted132(double sigma, double radius) {
+  RegistrationPrior prior;
+  prior.translation = {132.0, 0.0};
+  prior.translation_sigma = sigma;
+  prior.translation_radius = radius;
+  return prior;
+}
+
 // The roofs' pair 1-2 of a flight whose last steps spread widely (one earlier hop between layers
 // left three sigmas of 24 px): the prediction of the followed roofs is 132 px, the ground's peak
 // (108.9 px, the highest) lies inside that gate, the roofs' own peak (a tenth of its height)
 // where they were predicted. The result of observe() for it, with the PMT's reading of the
 // followed layer given by `stretch` (0: no PMT).
 PairMotion observedWithStretch(double stretch, PairObservations* out = nullptr) {
-  RegistrationPrior prior;
-  prior.translation = {132.0, 0.0};
-  prior.translation_sigma = 8.0;
-  prior.translation_radius = 60.0;
-  detail::Reference ref;
-  ref.translation = {132.0, 0.0};
-  ref.shift = 132.0;
-  ref.shift_sigma = 0.5;
   PairRegistration registration = withPeaks({{108.9, 1.0}, {132.0, 0.1}});
   registration.translation = {108.9, 0.0};
-  MatchResult pmt;
-  pmt.valid = stretch > 0.0;
-  pmt.value = stretch;
-  pmt.sigma = 0.002;
-  PairMotion initial;
-  const PairObservations obs =
-      detail::observe(registration, motionAlongX(108.9), pmt, MatchResult(), ref, EstimatorConfig(),
-                      kShiftPerBin, 1.0, 1.0, &prior, initial);
-  if (out) *out = obs;
-  return initial;
+  return observedAfter132(predicted132(8.0, 60.0), 0.5, registration, stretch, 0.002, out);
 }
 
 // The PMT reads the roofs where they were predicted: the ground's peak is another layer, not a
@@ -178,26 +188,11 @@ TEST(ObserveFollowedLayer, APeakThePatternMatchConfirmsStands) {
 // followed layer's own peak. Where the PMT is as loose as the layers are close, it cannot tell
 // them apart and the window's peak stands.
 PairMotion observedWithNeighbour(double pmt_sigma) {
-  RegistrationPrior prior;
-  prior.translation = {132.0, 0.0};
-  prior.translation_sigma = 0.5;
-  prior.translation_radius = 40.0;
-  detail::Reference ref;
-  ref.translation = {132.0, 0.0};
-  ref.shift = 132.0;
-  ref.shift_sigma = 0.3;
   PairRegistration registration = withPeaks({{108.9, 1.0}, {132.0, 0.3}});
   registration.translation = {108.9, 0.0};
   registration.followed_translation = {125.9, 0.0};
   registration.followed_confidence = 1.0;
-  MatchResult pmt;
-  pmt.valid = true;
-  pmt.value = 1.0;
-  pmt.sigma = pmt_sigma;
-  PairMotion initial;
-  detail::observe(registration, motionAlongX(108.9), pmt, MatchResult(), ref, EstimatorConfig(), kShiftPerBin,
-                  1.0, 1.0, &prior, initial);
-  return initial;
+  return observedAfter132(predicted132(0.5, 40.0), 0.3, registration, 1.0, pmt_sigma);
 }
 
 TEST(ObserveFollowedLayer, ATightPatternMatchTellsANeighbouringLayer) {
@@ -205,6 +200,8 @@ TEST(ObserveFollowedLayer, ATightPatternMatchTellsANeighbouringLayer) {
   EXPECT_NEAR(observedWithNeighbour(0.03).shift(), 125.9, 1e-9);
 }
 
+// A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose
+// highest peak agreed with it: one reading is another layer's, and the spread says by how much.
 TEST(LengthSpread, OtherReadingsInsideTheWindowWiden) {
   EXPECT_NEAR(detail::lengthSpread(108.9, {108.9, 131.8}, 0.05, 40.0), 22.9, 1e-9);
   // The largest of several; unbounded without a window.
