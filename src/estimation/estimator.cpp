@@ -158,6 +158,8 @@ struct Estimator::State {
   // they held) for the length the motion so far predicts: that step (oefmt mode), with
   // est.measured12 and est.vouched_length set.
   std::optional<PairMotion> corroboratedStep(Estimate& est) const;
+  std::optional<double> followedLayerAtSteadyLength(const PairRegistration& r, double steady,
+                                                    double agreement) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
   std::vector<double> layerShifts(const PairRegistration& registration) const;
   // The length the motion so far predicts for pair 1-2 [px] (needs have01).
@@ -681,14 +683,39 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
     return std::nullopt;
   }
   const double steady = steadyLength(est);
-  const std::optional<LayerRatioMemory::Vouched> vouched = layer_ratios.vouch(layerShifts(r), steady);
-  if (!vouched || !(std::fabs(vouched->length - steady) <= 2.0 * kLayerRatioTolerance * steady)) return std::nullopt;
+  const double agreement = 2.0 * kLayerRatioTolerance * steady;
+  double vouched_length = 0.0;
+  const std::optional<LayerRatioMemory::Vouched> held = layer_ratios.vouch(layerShifts(r), steady);
+  if (held && std::fabs(held->length - steady) <= agreement) {
+    vouched_length = held->length;
+  } else if (const std::optional<double> own = followedLayerAtSteadyLength(r, steady, agreement)) {
+    vouched_length = *own;
+  }
+  if (!(vouched_length > 0.0)) return std::nullopt;
   const PairMotion measured = detail::calibrated(r, config.uncertainty);
-  const PairMotion step = atVouchedLength(measured, vouched->length);
+  const PairMotion step = atVouchedLength(measured, vouched_length);
   if (!(cv::norm(step.translation - prior12->translation) <= prior12->translation_radius)) return std::nullopt;
   est.measured12 = measured;
-  est.vouched_length = vouched->length;
+  est.vouched_length = vouched_length;
   return step;
+}
+
+std::optional<double> Estimator::State::followedLayerAtSteadyLength(const PairRegistration& r, double steady,
+                                                                    double agreement) const {
+  // The memory vouches for nothing while the layers in view are new to it (it needs most of a
+  // window of steps) and for a wrong length while they are settling. Then the followed layer's own
+  // peak at the predicted length stands for it: in the energy vector, or as the pair's highest
+  // correlation peak. It must sit as close to the prediction as a held ratio must.
+  const double shift_per_bin = registrar.shiftPerBin();
+  if (shift_per_bin > 0.0) {
+    if (const std::optional<double> bin = peakNear(r.translation_energy, steady / shift_per_bin,
+                                                   agreement / shift_per_bin,
+                                                   config.tracking.steady_layer_min_fraction)) {
+      return *bin * shift_per_bin;
+    }
+  }
+  if (std::fabs(r.shift - steady) <= agreement) return r.shift;
+  return std::nullopt;
 }
 
 Estimator::Estimator(const EstimatorConfig& config) : config_(config) {

@@ -83,7 +83,8 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
       {"vouched_length_px", "px",
        "oefmt: the step length the depth layers in view vouched for by the ratios they held over the last "
        "steps, where the step's own broke them and was replaced by it, or where the pair was too weak to "
-       "register on its own and was tracked on it (degraded 1); 0 = the step's own length stood",
+       "register on its own and was tracked on it (degraded 1; before the ratios held, the followed "
+       "layer's own peak at the predicted length); 0 = the step's own length stood",
        [](const Estimate& e) { return format("%.4f", e.vouched_length); }},
       {"plane_tilt_x_rad", "rad",
        "levelled frames: the ground plane's tilt left in the level view, its normal's component "
