@@ -24,6 +24,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using detail::alongTrackSigma;
+using detail::medianOf;
 using detail::kMinShiftSigma;
 
 double msSince(Clock::time_point start) {
@@ -66,11 +67,6 @@ constexpr double kTranslationWindowFloor = 2.0;
 // overlap moves 0.7 N).
 constexpr double kMaxPairShiftFraction = 0.45;
 
-// The middle value (the upper middle of an even count).
-double medianOf(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
 
 // Whether a pair's rotation and zoom lie within the prediction's window (true without one).
 bool withinWindow(const PairMotion& motion, const std::optional<RegistrationPrior>& prior) {
@@ -395,7 +391,7 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   // The frame that restarts the window is predicted too: the vehicle kept moving while frames
   // failed, and a held pose would drop one step from the trajectory.
   if (config.tracking.predict_failed_frames && last_step && failed <= config.tracking.max_failed_frames + 1) {
-    PairMotion predicted = *last_step;
+    PairMotion predicted = detail::extrapolatedStep(*last_step, recent_rates);
     const double spread = config.tracking.prediction_sigma * predicted.shift();
     predicted.translation_covariance += cv::Matx22d::eye() * (spread * spread + 1.0);
     predicted.rotation_sigma = std::hypot(predicted.rotation_sigma, kPredictedRotationSigma);

@@ -186,6 +186,24 @@ PairMotion perInterval(const PairMotion& m, int gap) {
   return out;
 }
 
+double medianOf(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>& rates) {
+  PairMotion step = last;
+  if (rates.empty()) return step;
+  std::vector<double> rotations, log_zooms;
+  for (const PairMotion& m : rates) {
+    rotations.push_back(m.rotation);
+    log_zooms.push_back(m.log_zoom);
+  }
+  step.rotation = medianOf(std::move(rotations));
+  step.log_zoom = medianOf(std::move(log_zooms));
+  return step;
+}
+
 StretchMatchOptions stretchOptions(const MatchingConfig& m, double init, double key,
                                    double reference_bin) {
   StretchMatchOptions o;

@@ -3,6 +3,9 @@
 // optimizer observations.
 #pragma once
 
+#include <deque>
+#include <vector>
+
 #include "oefmt/estimation/estimator_config.h"
 #include "oefmt/estimation/local_optimizer.h"
 #include "oefmt/estimation/pair_motion.h"
@@ -27,6 +30,16 @@ PairMotion withLength(const PairMotion& motion, double length, double along, dou
 
 /// The motion of one frame interval from a motion spanning `gap` intervals.
 PairMotion perInterval(const PairMotion& motion, int gap);
+
+/// The middle value (the upper middle of an even count); `values` must not be empty.
+double medianOf(std::vector<double> values);
+
+/// The step a frame that could not be registered is extrapolated with: the last step's
+/// translation, turned and zoomed at the median rates of `rates` (the last steps that measured
+/// their rotation and zoom; the last step's own rates when there are none). The frames fail where
+/// the registration weakens, and the last step before them is often the one whose turn went
+/// wrong: repeated on every predicted frame it bent the trajectory by as much each time.
+PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>& rates);
 
 /// PMT options; the no-motion bins are skipped when the reference peak lies well beyond them.
 StretchMatchOptions stretchOptions(const MatchingConfig& matching, double init, double key,

@@ -27,8 +27,9 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        [](const Estimate& e) { return format("%zu", e.frame_index); }},
       {"stamp", "s", "the frame's time stamp", [](const Estimate& e) { return format("%.9f", e.stamp); }},
       {"state", "",
-       "started (the origin), tracking (registered), predicted (extrapolated with the last motion), "
-       "held (the pose kept), restarted (the window starts again from this frame)",
+       "started (the origin), tracking (registered), predicted (extrapolated with the last motion at the "
+       "last steps' median turn and zoom), held (the pose kept), restarted (the window starts again "
+       "from this frame)",
        [](const Estimate& e) { return std::string(toString(e.state)); }},
       {"degraded", "", "1 when the pose did not come from a confident registration of this frame",
        [](const Estimate& e) { return format("%d", e.degraded ? 1 : 0); }},

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <deque>
 #include <vector>
 
 #include "estimation/estimator_measurements.h"
@@ -228,6 +229,30 @@ TEST(LengthSpread, WidensOnlyAlongTheStep) {
   EXPECT_NEAR((across.t() * wide.translation_covariance * across)(0), 0.09, 1e-9);
   EXPECT_EQ(wide.translation, m.translation);
   EXPECT_EQ(detail::withAlongTrackSpread(m, 0.0).translation_covariance, m.translation_covariance);
+}
+
+// The last step before frames fail turned 0.7 degrees where the steps before it held the heading:
+// the predicted frames turn at the steps' median rate, not by the last step's turn each time.
+TEST(ExtrapolatedStep, TurnsAndZoomsAtTheLastStepsMedianRates) {
+  std::deque<PairMotion> rates(3, motionAlongX(40.0));
+  rates[0].rotation = 0.001;
+  rates[0].log_zoom = 0.002;
+  rates[1].rotation = -0.0005;
+  rates[1].log_zoom = 0.001;
+  rates[2].rotation = 0.0127;
+  rates[2].log_zoom = -0.01;
+  PairMotion last = rates.back();
+  last.translation = {41.0, 2.0};
+  const PairMotion step = detail::extrapolatedStep(last, rates);
+  EXPECT_DOUBLE_EQ(step.rotation, 0.001);
+  EXPECT_DOUBLE_EQ(step.log_zoom, 0.001);
+  // The translation and its covariance stay the last step's.
+  EXPECT_EQ(step.translation, last.translation);
+  EXPECT_EQ(step.translation_covariance, last.translation_covariance);
+  // Without steps that measured their rates, the last step stands whole.
+  const PairMotion alone = detail::extrapolatedStep(last, {});
+  EXPECT_DOUBLE_EQ(alone.rotation, last.rotation);
+  EXPECT_DOUBLE_EQ(alone.log_zoom, last.log_zoom);
 }
 
 }  // namespace
