@@ -67,7 +67,6 @@ constexpr double kTranslationWindowFloor = 2.0;
 // overlap moves 0.7 N).
 constexpr double kMaxPairShiftFraction = 0.45;
 
-
 // Whether a pair's rotation and zoom lie within the prediction's window (true without one).
 bool withinWindow(const PairMotion& motion, const std::optional<RegistrationPrior>& prior) {
   return !prior || (std::fabs(wrapToPi(motion.rotation - prior->rotation)) <= prior->rotation_window &&
@@ -154,6 +153,8 @@ struct Estimator::State {
   // they held) for the length the motion so far predicts: that step (oefmt mode), with
   // est.measured12 and est.vouched_length set.
   std::optional<PairMotion> corroboratedStep(Estimate& est) const;
+  // Where the layer memory cannot vouch: the followed layer's own peak within `agreement` [px]
+  // of the steady length (energy vector, else the highest correlation peak) [px], or none.
   std::optional<double> followedLayerAtSteadyLength(const PairRegistration& r, double steady,
                                                     double agreement) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
@@ -671,7 +672,8 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
   // stand at the depth ratios they held. A length they vouch for that the motion so far also
   // predicts (within twice the ratios' own tolerance) is two independent readings agreeing: the
   // pair is tracked on it instead of being lost. A noise peak would need to fall, with its
-  // direction, in the acceleration window and at a held ratio of the predicted length.
+  // direction, in the acceleration window and at a held ratio of the predicted length (or, before
+  // the ratios hold, within 2 % of the predicted length itself).
   const PairRegistration& r = est.registration12;
   if (!have01 || !prior12 || !(prior12->translation_radius > 0.0) ||
       r.status != RegistrationStatus::kLowConfidence || !(r.confidence > 0.0) ||
