@@ -58,6 +58,15 @@ constexpr std::size_t kPredictionSteps = 3;
 constexpr int kLayerRatioFrames = 12;
 constexpr int kLayerRatioSupport = 8;
 constexpr double kLayerRatioTolerance = 0.01;
+// A measured turn is weighed against the turn the last steps' rates predict for it
+// (detail::TurnDeviations): by the spread of the last 12 accepted turns' deviations from their
+// predictions, once 6 of them are known. A deviation beyond 4 of those spreads is an outlier: a
+// normal error lies within 4 sigmas all but once in 15 000. The spread is at least a tenth of a
+// rotation bin, within which the surface's interpolation itself scatters.
+constexpr std::size_t kTurnDeviationFrames = 12;
+constexpr std::size_t kTurnDeviationSupport = 6;
+constexpr double kTurnGateSpreads = 4.0;
+constexpr double kTurnDeviationFloorBins = 0.1;
 // Smallest radius of the translation window [px]: sub-pixel noise and rounding.
 constexpr double kTranslationWindowFloor = 2.0;
 
@@ -113,6 +122,7 @@ struct Estimator::State {
     last_step.reset();
     recent_steps.clear();
     recent_rates.clear();
+    turn_deviations.clear();
     plane_tilt.clear();
     layer_ratios.clear();
     levelled = false;
@@ -146,6 +156,9 @@ struct Estimator::State {
   // that covers the difference, and marked degraded; after tracking.max_failed_frames such steps
   // in a row the measurements are believed and the motion model starts over.
   PairMotion plausibleStep(const PairMotion& step, Estimate& est);
+  // The step with the predicted turn where its own turn is an outlier of the recent deviations
+  // from the predictions (at most one step in a row).
+  PairMotion consistentTurn(const PairMotion& step, Estimate& est);
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
@@ -226,6 +239,8 @@ struct Estimator::State {
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
   std::deque<PairMotion> recent_steps;
   std::deque<PairMotion> recent_rates;  // of those, the steps whose rotation/zoom were measured
+  detail::TurnDeviations turn_deviations{kTurnDeviationFrames, kTurnDeviationSupport, kTurnGateSpreads,
+                                        kTurnDeviationFloorBins * CV_PI / config.registration.size};
   int implausible_steps = 0;  // steps in a row replaced by the prediction (plausibleStep)
   // The followed layer's length against the layers in view over the last measured steps.
   LayerRatioMemory layer_ratios{kLayerRatioFrames, kLayerRatioSupport, kLayerRatioTolerance};
@@ -441,6 +456,7 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
     implausible_steps = 0;
     recent_steps.clear();
     recent_rates.clear();
+    turn_deviations.clear();
     return step;
   }
   est.degraded = true;
@@ -449,6 +465,17 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
   predicted.translation = prior12->translation;
   const double spread = cv::norm(off);
   predicted.translation_covariance = step.translation_covariance + cv::Matx22d::eye() * (spread * spread);
+  return predicted;
+}
+
+PairMotion Estimator::State::consistentTurn(const PairMotion& step, Estimate& est) {
+  if (!prior12 || est.registration12.rotation_zoom_candidate == PairRegistration::kPredicted) return step;
+  if (!turn_deviations.outlier(wrapToPi(step.rotation - prior12->rotation))) return step;
+  est.degraded = true;
+  est.turn_predicted = true;
+  PairMotion predicted = step;
+  predicted.rotation = prior12->rotation;
+  predicted.rotation_sigma = std::hypot(turn_deviations.spread(), prior12->rotation_sigma);
   return predicted;
 }
 
@@ -628,6 +655,7 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
   } else if (++unconfirmed_steps > config.tracking.max_failed_frames) {
     recent_steps.clear();
     recent_rates.clear();
+    turn_deviations.clear();
     unconfirmed_steps = 0;
   }
   motion01 = step;
@@ -908,7 +936,12 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       } else if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01) {
         step = s.oefmtStep(frame, est, with02);
       }
-      if (config_.mode == EstimatorMode::kOefmt) step = s.plausibleStep(s.vouchedStep(step, est), est);
+      if (config_.mode == EstimatorMode::kOefmt) {
+        step = s.plausibleStep(s.vouchedStep(step, est), est);
+        // A gyro's turn is a measurement of its own, not the rates' extrapolation: a turn that
+        // registered within its window stands.
+        if (!turn) step = s.consistentTurn(step, est);
+      }
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }
   }

@@ -204,6 +204,32 @@ PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>
   return step;
 }
 
+TurnDeviations::TurnDeviations(std::size_t frames, std::size_t support, double gate, double floor)
+    : frames_(frames), support_(std::min(support, frames)), gate_(gate), floor_(floor) {}
+
+bool TurnDeviations::outlier(double deviation) {
+  if (deviations_.size() >= support_ && !last_outlier_ && std::fabs(deviation) > gate_ * spread()) {
+    last_outlier_ = true;
+    return true;
+  }
+  last_outlier_ = false;
+  deviations_.push_back(std::fabs(deviation));
+  while (deviations_.size() > frames_) deviations_.pop_front();
+  return false;
+}
+
+double TurnDeviations::spread() const {
+  // The median absolute deviation over that of a normal distribution's sigma.
+  constexpr double kMedianAbsoluteToSigma = 1.4826;
+  if (deviations_.empty()) return floor_;
+  return std::max(kMedianAbsoluteToSigma * medianOf({deviations_.begin(), deviations_.end()}), floor_);
+}
+
+void TurnDeviations::clear() {
+  deviations_.clear();
+  last_outlier_ = false;
+}
+
 StretchMatchOptions stretchOptions(const MatchingConfig& m, double init, double key,
                                    double reference_bin) {
   StretchMatchOptions o;

@@ -33,6 +33,10 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        [](const Estimate& e) { return std::string(toString(e.state)); }},
       {"degraded", "", "1 when the pose did not come from a confident registration of this frame",
        [](const Estimate& e) { return format("%d", e.degraded ? 1 : 0); }},
+      {"turn_predicted", "",
+       "1 when the measured turn was an outlier of the last turns' deviations from their predictions "
+       "and the predicted turn was integrated",
+       [](const Estimate& e) { return format("%d", e.turn_predicted ? 1 : 0); }},
       {"theta_rad", "rad", "pair 1-2's registered rotation (counter-clockwise on screen)",
        [](const Estimate& e) { return format("%.8f", pair12(e).rotation); }},
       {"zoom", "", "pair 1-2's registered zoom (the newer frame looks this much larger)",

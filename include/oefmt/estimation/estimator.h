@@ -57,6 +57,9 @@ struct Estimate {
   /// The measured step departed from the motion so far by more than the vehicle's acceleration
   /// allows: the predicted step was integrated instead (with a covariance covering both).
   bool step_implausible = false;
+  /// The measured turn deviated from the predicted one by several times what the last turns did
+  /// (an outlier of the registration): the predicted turn was integrated instead.
+  bool turn_predicted = false;
 
   // Raw registrations (energy vectors included; empty vectors in fmt mode).
   PairRegistration registration12;
