@@ -58,15 +58,15 @@ constexpr std::size_t kPredictionSteps = 3;
 constexpr int kLayerRatioFrames = 12;
 constexpr int kLayerRatioSupport = 8;
 constexpr double kLayerRatioTolerance = 0.01;
-// A measured turn is weighed against the turn the last steps' rates predict for it
-// (detail::TurnDeviations): by the spread of the last 12 accepted turns' deviations from their
+// A measured turn or zoom is weighed against the one the last steps' rates predict for it
+// (detail::RateDeviations): by the spread of the last 12 accepted readings' deviations from their
 // predictions, once 6 of them are known. A deviation beyond 4 of those spreads is an outlier: a
 // normal error lies within 4 sigmas all but once in 15 000. The spread is at least a tenth of a
-// rotation bin, within which the surface's interpolation itself scatters.
-constexpr std::size_t kTurnDeviationFrames = 12;
-constexpr std::size_t kTurnDeviationSupport = 6;
-constexpr double kTurnGateSpreads = 4.0;
-constexpr double kTurnDeviationFloorBins = 0.1;
+// surface bin, within which the surface's interpolation itself scatters.
+constexpr std::size_t kRateDeviationFrames = 12;
+constexpr std::size_t kRateDeviationSupport = 6;
+constexpr double kRateGateSpreads = 4.0;
+constexpr double kRateDeviationFloorBins = 0.1;
 // Smallest radius of the translation window [px]: sub-pixel noise and rounding.
 constexpr double kTranslationWindowFloor = 2.0;
 
@@ -123,6 +123,7 @@ struct Estimator::State {
     recent_steps.clear();
     recent_rates.clear();
     turn_deviations.clear();
+    zoom_deviations.clear();
     plane_tilt.clear();
     layer_ratios.clear();
     levelled = false;
@@ -156,9 +157,10 @@ struct Estimator::State {
   // that covers the difference, and marked degraded; after tracking.max_failed_frames such steps
   // in a row the measurements are believed and the motion model starts over.
   PairMotion plausibleStep(const PairMotion& step, Estimate& est);
-  // The step with the predicted turn where its own turn is an outlier of the recent deviations
-  // from the predictions (at most one step in a row).
-  PairMotion consistentTurn(const PairMotion& step, Estimate& est);
+  // The step with the predicted turn (zoom) where its own turn (zoom) is an outlier of the recent
+  // deviations from the predictions (at most one step in a row); the turn not where a gyro gave
+  // the pair's turn.
+  PairMotion consistentRates(const PairMotion& step, bool gyro_turn, Estimate& est);
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
@@ -239,8 +241,10 @@ struct Estimator::State {
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
   std::deque<PairMotion> recent_steps;
   std::deque<PairMotion> recent_rates;  // of those, the steps whose rotation/zoom were measured
-  detail::TurnDeviations turn_deviations{kTurnDeviationFrames, kTurnDeviationSupport, kTurnGateSpreads,
-                                        kTurnDeviationFloorBins * CV_PI / config.registration.size};
+  detail::RateDeviations turn_deviations{kRateDeviationFrames, kRateDeviationSupport, kRateGateSpreads,
+                                        kRateDeviationFloorBins * CV_PI / config.registration.size};
+  detail::RateDeviations zoom_deviations{kRateDeviationFrames, kRateDeviationSupport, kRateGateSpreads,
+                                        kRateDeviationFloorBins * registrar.logZoomPerBin()};
   int implausible_steps = 0;  // steps in a row replaced by the prediction (plausibleStep)
   // The followed layer's length against the layers in view over the last measured steps.
   LayerRatioMemory layer_ratios{kLayerRatioFrames, kLayerRatioSupport, kLayerRatioTolerance};
@@ -457,6 +461,7 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
     recent_steps.clear();
     recent_rates.clear();
     turn_deviations.clear();
+    zoom_deviations.clear();
     return step;
   }
   est.degraded = true;
@@ -468,15 +473,23 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
   return predicted;
 }
 
-PairMotion Estimator::State::consistentTurn(const PairMotion& step, Estimate& est) {
+PairMotion Estimator::State::consistentRates(const PairMotion& step, bool gyro_turn, Estimate& est) {
   if (!prior12 || est.registration12.rotation_zoom_candidate == PairRegistration::kPredicted) return step;
-  if (!turn_deviations.outlier(wrapToPi(step.rotation - prior12->rotation))) return step;
-  est.degraded = true;
-  est.turn_predicted = true;
-  PairMotion predicted = step;
-  predicted.rotation = prior12->rotation;
-  predicted.rotation_sigma = std::hypot(turn_deviations.spread(), prior12->rotation_sigma);
-  return predicted;
+  PairMotion out = step;
+  // A gyro's turn is a measurement of its own, not the rates' extrapolation: a turn that
+  // registered within its window stands.
+  if (!gyro_turn && turn_deviations.outlier(wrapToPi(step.rotation - prior12->rotation))) {
+    est.turn_predicted = true;
+    out.rotation = prior12->rotation;
+    out.rotation_sigma = std::hypot(turn_deviations.spread(), prior12->rotation_sigma);
+  }
+  if (zoom_deviations.outlier(step.log_zoom - prior12->log_zoom)) {
+    est.zoom_predicted = true;
+    out.log_zoom = prior12->log_zoom;
+    out.log_zoom_sigma = std::hypot(zoom_deviations.spread(), prior12->log_zoom_sigma);
+  }
+  if (est.turn_predicted || est.zoom_predicted) est.degraded = true;
+  return out;
 }
 
 void Estimator::State::slideTo(WindowFrame&& frame, const PairMotion& predicted) {
@@ -656,6 +669,7 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
     recent_steps.clear();
     recent_rates.clear();
     turn_deviations.clear();
+    zoom_deviations.clear();
     unconfirmed_steps = 0;
   }
   motion01 = step;
@@ -937,10 +951,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
         step = s.oefmtStep(frame, est, with02);
       }
       if (config_.mode == EstimatorMode::kOefmt) {
-        step = s.plausibleStep(s.vouchedStep(step, est), est);
-        // A gyro's turn is a measurement of its own, not the rates' extrapolation: a turn that
-        // registered within its window stands.
-        if (!turn) step = s.consistentTurn(step, est);
+        step = s.consistentRates(s.plausibleStep(s.vouchedStep(step, est), est), turn.has_value(), est);
       }
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }

@@ -204,10 +204,10 @@ PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>
   return step;
 }
 
-TurnDeviations::TurnDeviations(std::size_t frames, std::size_t support, double gate, double floor)
+RateDeviations::RateDeviations(std::size_t frames, std::size_t support, double gate, double floor)
     : frames_(frames), support_(std::min(support, frames)), gate_(gate), floor_(floor) {}
 
-bool TurnDeviations::outlier(double deviation) {
+bool RateDeviations::outlier(double deviation) {
   if (deviations_.size() >= support_ && !last_outlier_ && std::fabs(deviation) > gate_ * spread()) {
     last_outlier_ = true;
     return true;
@@ -218,14 +218,14 @@ bool TurnDeviations::outlier(double deviation) {
   return false;
 }
 
-double TurnDeviations::spread() const {
+double RateDeviations::spread() const {
   // The median absolute deviation over that of a normal distribution's sigma.
   constexpr double kMedianAbsoluteToSigma = 1.4826;
   if (deviations_.empty()) return floor_;
   return std::max(kMedianAbsoluteToSigma * medianOf({deviations_.begin(), deviations_.end()}), floor_);
 }
 
-void TurnDeviations::clear() {
+void RateDeviations::clear() {
   deviations_.clear();
   last_outlier_ = false;
 }

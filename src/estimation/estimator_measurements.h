@@ -41,23 +41,24 @@ double medianOf(std::vector<double> values);
 /// wrong: repeated on every predicted frame it bent the trajectory by as much each time.
 PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>& rates);
 
-/// The deviations of the last measured turns from the turns the rates before them predicted,
-/// which tell a turn that is an outlier of the measurement from a change of the yaw rate.
-/// Where one pair's registration is pulled off the motion (another depth layer takes the
-/// translation peak, a periodic texture's alias), its rotation deviates from the prediction by
-/// several times what the steps before it did, while the prediction itself stays within their
-/// spread. One such turn in a row is taken as an outlier; a second is a change of the rate.
-class TurnDeviations {
+/// The deviations of the last measured rates (a pair's turn, or its log-zoom) from what the
+/// rates before them predicted, which tell a reading that is an outlier of the measurement from a
+/// change of the rate. Where one pair's registration is pulled off the motion (another depth
+/// layer takes the translation peak, a periodic texture's alias), its rotation or zoom deviates
+/// from the prediction by several times what the steps before it did, while the prediction
+/// itself stays within their spread. One such reading in a row is taken as an outlier; a second
+/// is a change of the rate.
+class RateDeviations {
  public:
   /// frames: how many of the last accepted deviations are remembered; support: how many are
-  /// needed before any turn is judged; gate: the outlier's distance in their spreads; floor: the
-  /// smallest spread [rad].
-  TurnDeviations(std::size_t frames, std::size_t support, double gate, double floor);
+  /// needed before any reading is judged; gate: the outlier's distance in their spreads; floor:
+  /// the smallest spread.
+  RateDeviations(std::size_t frames, std::size_t support, double gate, double floor);
 
-  /// Judges a turn that deviates by `deviation` [rad] from its prediction: true for an outlier
-  /// (not remembered). Any other turn is remembered.
+  /// Judges a reading that deviates by `deviation` from its prediction: true for an outlier
+  /// (not remembered). Any other reading is remembered.
   bool outlier(double deviation);
-  /// The remembered deviations' spread as a normal sigma (at least the floor) [rad].
+  /// The remembered deviations' spread as a normal sigma (at least the floor).
   double spread() const;
   void clear();
 
@@ -66,7 +67,7 @@ class TurnDeviations {
   std::size_t support_;
   double gate_;
   double floor_;
-  std::deque<double> deviations_;  // absolute values [rad]
+  std::deque<double> deviations_;  // absolute values
   bool last_outlier_ = false;
 };
 

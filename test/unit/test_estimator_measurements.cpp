@@ -257,10 +257,10 @@ TEST(ExtrapolatedStep, TurnsAndZoomsAtTheLastStepsMedianRates) {
 
 // A steady turn read to about 0.01 degrees, then one pair pulled 0.5 degrees off it: the outlier
 // is told, and not remembered. Two in a row are a change of the yaw rate: the second stands.
-TEST(TurnDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
+TEST(RateDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
   const double degree = CV_PI / 180.0;
   const double floor = 0.001 * degree;
-  detail::TurnDeviations turns(12, 6, 4.0, floor);
+  detail::RateDeviations turns(12, 6, 4.0, floor);
   const double steady[] = {0.010, -0.012, 0.006, -0.004, 0.011, -0.009, 0.008, -0.010};
   for (int k = 0; k < 5; ++k) EXPECT_FALSE(turns.outlier(steady[k] * degree)) << "too few to judge " << k;
   // Before `support` deviations are known nothing is judged, however far off.
@@ -276,7 +276,7 @@ TEST(TurnDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
   EXPECT_FALSE(turns.outlier(0.5 * degree)) << "a second one in a row is a change of the rate";
   EXPECT_TRUE(turns.outlier(-0.5 * degree)) << "after an accepted turn the gate holds again";
   // The floor: deviations of exactly zero still leave the floor's spread.
-  detail::TurnDeviations exact(12, 6, 4.0, floor);
+  detail::RateDeviations exact(12, 6, 4.0, floor);
   for (int k = 0; k < 6; ++k) EXPECT_FALSE(exact.outlier(0.0));
   EXPECT_DOUBLE_EQ(exact.spread(), floor);
   EXPECT_FALSE(exact.outlier(3.9 * floor));

@@ -60,6 +60,8 @@ struct Estimate {
   /// The measured turn deviated from the predicted one by several times what the last turns did
   /// (an outlier of the registration): the predicted turn was integrated instead.
   bool turn_predicted = false;
+  /// The same for the zoom: the predicted zoom was integrated instead of an outlier.
+  bool zoom_predicted = false;
 
   // Raw registrations (energy vectors included; empty vectors in fmt mode).
   PairRegistration registration12;
