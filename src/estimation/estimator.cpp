@@ -120,10 +120,7 @@ struct Estimator::State {
     failed = 0;
     anchor.reset();
     last_step.reset();
-    recent_steps.clear();
-    recent_rates.clear();
-    turn_deviations.clear();
-    zoom_deviations.clear();
+    forgetMotionModel();
     plane_tilt.clear();
     layer_ratios.clear();
     levelled = false;
@@ -131,6 +128,14 @@ struct Estimator::State {
     unconfirmed_steps = 0;
     started = false;
     last_stamp = -std::numeric_limits<double>::infinity();
+  }
+  // The motion model starts over from the next measurements: its steps, its rates and what it
+  // knows of their deviations from its predictions.
+  void forgetMotionModel() {
+    recent_steps.clear();
+    recent_rates.clear();
+    turn_deviations.clear();
+    zoom_deviations.clear();
   }
   void forgetPair01() {
     have01 = false;
@@ -458,10 +463,7 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
     // The measurements have disagreed with the model for longer than frames may fail: the
     // vehicle did change its motion. Believe them from here.
     implausible_steps = 0;
-    recent_steps.clear();
-    recent_rates.clear();
-    turn_deviations.clear();
-    zoom_deviations.clear();
+    forgetMotionModel();
     return step;
   }
   est.degraded = true;
@@ -666,10 +668,7 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
     }
     unconfirmed_steps = 0;
   } else if (++unconfirmed_steps > config.tracking.max_failed_frames) {
-    recent_steps.clear();
-    recent_rates.clear();
-    turn_deviations.clear();
-    zoom_deviations.clear();
+    forgetMotionModel();
     unconfirmed_steps = 0;
   }
   motion01 = step;
