@@ -165,7 +165,7 @@ struct Estimator::State {
   // The step with the predicted turn (zoom) where its own turn (zoom) is an outlier of the recent
   // deviations from the predictions (at most one step in a row); the turn not where a gyro gave
   // the pair's turn.
-  PairMotion consistentRates(const PairMotion& step, bool gyro_turn, Estimate& est);
+  PairMotion consistentRates(const PairMotion& step, double rates_rotation, bool gyro_turn, Estimate& est);
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
@@ -475,14 +475,18 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
   return predicted;
 }
 
-PairMotion Estimator::State::consistentRates(const PairMotion& step, bool gyro_turn, Estimate& est) {
+PairMotion Estimator::State::consistentRates(const PairMotion& step, double rates_rotation, bool gyro_turn,
+                                             Estimate& est) {
   if (!prior12 || est.registration12.rotation_zoom_candidate == PairRegistration::kPredicted) return step;
   PairMotion out = step;
-  // A gyro's turn is a measurement of its own, not the rates' extrapolation: a turn that
-  // registered within its window stands.
-  if (!gyro_turn && turn_deviations.outlier(wrapToPi(step.rotation - prior12->rotation))) {
+  // The turn is judged against the rates' extrapolation (`rates_rotation`). Where a gyro gave
+  // the turn (then the prediction's rotation), a reading off the rates stands if the gyro is off
+  // them too: the vehicle changed its rate. If the gyro kept to them, the extrapolation takes the
+  // reading's place, as without a gyro: the gyro's bias stays out of it.
+  const bool rate_changed = gyro_turn && turn_deviations.beyondGate(wrapToPi(prior12->rotation - rates_rotation));
+  if (!rate_changed && turn_deviations.outlier(wrapToPi(step.rotation - rates_rotation))) {
     est.turn_predicted = true;
-    out.rotation = prior12->rotation;
+    out.rotation = rates_rotation;
     out.rotation_sigma = std::hypot(turn_deviations.spread(), prior12->rotation_sigma);
   }
   if (zoom_deviations.outlier(step.log_zoom - prior12->log_zoom)) {
@@ -907,6 +911,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
+    const double rates_rotation12 = s.prior12 ? s.prior12->rotation : 0.0;
     if (turn && s.prior12) s.takeTurn(*s.prior12, -turn->first, turn->second);
     est.prediction12 = s.prior12;
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
@@ -950,7 +955,8 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
         step = s.oefmtStep(frame, est, with02);
       }
       if (config_.mode == EstimatorMode::kOefmt) {
-        step = s.consistentRates(s.plausibleStep(s.vouchedStep(step, est), est), turn.has_value(), est);
+        step = s.consistentRates(s.plausibleStep(s.vouchedStep(step, est), est), rates_rotation12,
+                                turn.has_value(), est);
       }
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }

@@ -207,8 +207,11 @@ PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>
 RateDeviations::RateDeviations(std::size_t frames, std::size_t support, double gate, double floor)
     : frames_(frames), support_(std::min(support, frames)), gate_(gate), floor_(floor) {}
 
+bool RateDeviations::beyondGate(double deviation) const {
+  return deviations_.size() >= support_ && std::fabs(deviation) > gate_ * spread();
+}
 bool RateDeviations::outlier(double deviation) {
-  if (deviations_.size() >= support_ && !last_outlier_ && std::fabs(deviation) > gate_ * spread()) {
+  if (!last_outlier_ && beyondGate(deviation)) {
     last_outlier_ = true;
     return true;
   }

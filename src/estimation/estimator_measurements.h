@@ -58,6 +58,9 @@ class RateDeviations {
   /// Judges a reading that deviates by `deviation` from its prediction: true for an outlier
   /// (not remembered). Any other reading is remembered.
   bool outlier(double deviation);
+  /// Whether `deviation` lies beyond the gate, judged without remembering it (false until the
+  /// support is known).
+  bool beyondGate(double deviation) const;
   /// The remembered deviations' spread as a normal sigma (at least the floor).
   double spread() const;
   void clear();
