@@ -264,6 +264,7 @@ TEST(RateDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
   const double steady[] = {0.010, -0.012, 0.006, -0.004, 0.011, -0.009, 0.008, -0.010};
   for (int k = 0; k < 5; ++k) EXPECT_FALSE(turns.outlier(steady[k] * degree)) << "too few to judge " << k;
   // Before `support` deviations are known nothing is judged, however far off.
+  EXPECT_FALSE(turns.beyondGate(0.5 * degree)) << "nothing judged before the support";
   EXPECT_FALSE(turns.outlier(0.5 * degree));
   turns.clear();
   for (double d : steady) EXPECT_FALSE(turns.outlier(d * degree));
@@ -271,6 +272,11 @@ TEST(RateDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
   EXPECT_GT(spread, 0.009 * degree);
   EXPECT_LT(spread, 0.016 * degree);
   EXPECT_FALSE(turns.outlier(3.5 * spread)) << "within the gate";
+  // beyondGate judges (a gyro's turn) without remembering or counting it as a step in a row.
+  const double before = turns.spread();
+  EXPECT_TRUE(turns.beyondGate(0.5 * degree));
+  EXPECT_FALSE(turns.beyondGate(3.5 * spread));
+  EXPECT_DOUBLE_EQ(turns.spread(), before);
   EXPECT_TRUE(turns.outlier(-0.5 * degree));
   EXPECT_DOUBLE_EQ(turns.spread(), spread) << "an outlier is not remembered";
   EXPECT_FALSE(turns.outlier(0.5 * degree)) << "a second one in a row is a change of the rate";
