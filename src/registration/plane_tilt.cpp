@@ -19,6 +19,14 @@ double logZoomOfTilt(const cv::Point2d& tilt, const cv::Point2d& translation) {
   return 1.5 * tilt.dot(translation);
 }
 
+double rotationOfTilt(const cv::Point2d& tilt, const cv::Point2d& translation) {
+  return 0.5 * (translation.x * tilt.y - translation.y * tilt.x);
+}
+
+double rotationOfSlope(double stretch_a, double stretch_b, const cv::Point2d& translation) {
+  return rotationOfTilt(tiltFromStretch(stretch_a, stretch_b, translation), translation);
+}
+
 double logZoomOfSlope(double stretch_a, double stretch_b, const cv::Point2d& translation) {
   return 0.5 * tiltFromStretch(stretch_a, stretch_b, translation).dot(translation);
 }

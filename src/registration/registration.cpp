@@ -168,11 +168,17 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   }
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
-  if (!plane_tilt) {
-    // A levelled view keeps its attitude source's error as a perspective that the similarity
-    // and stretch do not model, and the refined rotation takes up part of it.
-    result.refined_rotation = refined.similarity.rotation;
-    result.refined_rotation_sigma = refined.rotation_sigma;
+  result.refined_rotation = refined.similarity.rotation;
+  result.refined_rotation_sigma = refined.rotation_sigma;
+  if (plane_tilt) {
+    // A levelled view off by its attitude source's error reads the turn off by the rank-one
+    // term's antisymmetric part, which the fitted stretch tells (plane_tilt.h): the rotation and
+    // stretch read together are the turn, with the sigma of that combination.
+    const cv::Point2d d = refined.similarity.translation;
+    result.refined_rotation += rotationOfSlope(refined.similarity.stretch_a, refined.similarity.stretch_b, d);
+    const cv::Vec3d gradient(1.0, rotationOfSlope(1.0, 0.0, d), rotationOfSlope(0.0, 1.0, d));
+    const double variance = (gradient.t() * refined.rotation_stretch_covariance * gradient)(0);
+    if (variance > 0.0) result.refined_rotation_sigma = std::sqrt(variance);
   }
   result.stretch_a = refined.similarity.stretch_a;
   result.stretch_b = refined.similarity.stretch_b;
@@ -331,6 +337,12 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   if (surfaces != nullptr) surfaces->rotation_zoom = rotation_zoom_surface_.clone();
   const double translation_confidence =
       registerTranslation(older, newer, method, result, true, prior);
+  // A levelled view off by its attitude source's error reads a small turn as it moves
+  // (plane_tilt.h): the tilt the estimator tracks takes it out, as it does the zoom's.
+  if (plane_tilt_) {
+    result.rotation += rotationOfTilt(*plane_tilt_, result.translation);
+    if (std::fabs(result.rotation) > CV_PI) result.rotation = wrapAngle(result.rotation);
+  }
   if (surfaces != nullptr) {
     surfaces->translation = surface_.clone();
     surfaces->translation_polar =

@@ -430,7 +430,14 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     if (iteration + 1 == iterations) {
       // How closely the last step's pixels pin the rotation: sigma^2 (J^T W J)^-1, the weights
       // read as inverse variances (an approximation for the biweight's; calibrated by its user).
-      out.rotation_sigma = std::sqrt(std::max(normal.inv(cv::DECOMP_CHOLESKY)(0, 0) * (sigma * sigma), 0.0));
+      const Normal inverse = normal.inv(cv::DECOMP_CHOLESKY);
+      out.rotation_sigma = std::sqrt(std::max(inverse(0, 0) * (sigma * sigma), 0.0));
+      if (fit_stretch) {
+        const int index[3] = {0, 6, 7};
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) out.rotation_stretch_covariance(a, b) = inverse(index[a], index[b]) * (sigma * sigma);
+        }
+      }
     }
     current.rotation += step[0];
     current.log_zoom += step[1];

@@ -12,6 +12,9 @@
 // 1.5 u.v, and flying L the read zoom is off by 1.5 δ L / d, a climb or descent that is not there.
 // A level camera over a sloping surface sees the same images, but there t_z is the climb and n.t
 // the surface's rise: the zoom that carries the altitude is the read zoom plus u.v / 2.
+// The term's antisymmetric part, (u v^T - v u^T) / 2, is a turn of half the tilt across the
+// motion: both views read it as one, though neither turned. Along a flight whose attitude error
+// leans across the track it is the same every frame, and the heading drifts.
 //
 // In pixels the tilt is v / f [1/px]: a pair that moved by d [px] is stretched along d by
 // -(tilt . d) / 2 (the stretch of S = [a b; b -a] along a unit vector w is w^T S w), and its read
@@ -29,6 +32,18 @@ cv::Point2d tiltFromStretch(double stretch_a, double stretch_b, const cv::Point2
 /// The change of ln(zoom) that a tilt [1/px] makes the registration miss on a pair that moved by
 /// `translation` [px]: add it to the read ln(zoom).
 double logZoomOfTilt(const cv::Point2d& tilt, const cv::Point2d& translation);
+
+/// The change of rotation [rad] that a tilt [1/px] makes the registration miss on a pair that
+/// moved by `translation` [px]: add it to the read rotation. The rank-one term's antisymmetric
+/// part: half the tilt across the motion times the motion's length. A fit of the pair's linear
+/// map (rotation, zoom and stretch: similarity_refinement.h) reads all of it into its rotation;
+/// the log-polar surface reads the spectrum's angular shift, which the term's stretch spreads
+/// over the directions, and locks part of it to the nearest bin.
+double rotationOfTilt(const cv::Point2d& tilt, const cv::Point2d& translation);
+
+/// rotationOfTilt of the tilt that a pair's stretch reads (tiltFromStretch): linear in the
+/// stretch, so that its sigma follows from the fit's covariance.
+double rotationOfSlope(double stretch_a, double stretch_b, const cv::Point2d& translation);
 
 /// A level camera over a surface that slopes: the ln(zoom) to add to a pair's read zoom so that
 /// it carries the camera's climb (t_z / d) and not the surface's rise under the motion. The read

@@ -49,6 +49,9 @@ struct SimilarityRefinement {
   /// equations and the residuals' robust sigma (0: no step was solved). It describes the pixels'
   /// noise, not a model that does not fit (several depth layers): calibrate before use.
   double rotation_sigma = 0.0;
+  /// Covariance of (rotation, stretch_a, stretch_b) from the same normal equations, for a reading
+  /// that combines them (zero when no step was solved or the stretch was not fitted).
+  cv::Matx33d rotation_stretch_covariance = cv::Matx33d::zeros();
   /// Blocks of the image (of 64) left out because another depth layer's shift fits them better.
   int dropped_blocks = 0;
 };
