@@ -163,8 +163,8 @@ struct Estimator::State {
   // in a row the measurements are believed and the motion model starts over.
   PairMotion plausibleStep(const PairMotion& step, Estimate& est);
   // The step with the predicted turn (zoom) where its own turn (zoom) is an outlier of the recent
-  // deviations from the predictions (at most one step in a row); the turn not where a gyro gave
-  // the pair's turn.
+  // deviations from the predictions (at most one step in a row); the turn not where a gyro's turn
+  // is off the rates' prediction (`rates_rotation`) as well.
   PairMotion consistentRates(const PairMotion& step, double rates_rotation, bool gyro_turn, Estimate& est);
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
