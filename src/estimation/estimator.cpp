@@ -483,7 +483,8 @@ PairMotion Estimator::State::consistentRates(const PairMotion& step, double rate
   // the turn (then the prediction's rotation), a reading off the rates stands if the gyro is off
   // them too: the vehicle changed its rate. If the gyro kept to them, the extrapolation takes the
   // reading's place, as without a gyro: the gyro's bias stays out of it.
-  const bool rate_changed = gyro_turn && turn_deviations.beyondGate(wrapToPi(prior12->rotation - rates_rotation));
+  const bool rate_changed =
+      gyro_turn && turn_deviations.beyondGate(wrapToPi(prior12->rotation - rates_rotation));
   if (!rate_changed && turn_deviations.outlier(wrapToPi(step.rotation - rates_rotation))) {
     est.turn_predicted = true;
     out.rotation = rates_rotation;

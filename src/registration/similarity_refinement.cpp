@@ -433,9 +433,11 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       const Normal inverse = normal.inv(cv::DECOMP_CHOLESKY);
       out.rotation_sigma = std::sqrt(std::max(inverse(0, 0) * (sigma * sigma), 0.0));
       if (fit_stretch) {
-        const int index[3] = {0, 6, 7};
+        const int index[3] = {0, 6, 7};  // rotation, stretch a, stretch b
         for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) out.rotation_stretch_covariance(a, b) = inverse(index[a], index[b]) * (sigma * sigma);
+          for (int b = 0; b < 3; ++b) {
+            out.rotation_stretch_covariance(a, b) = inverse(index[a], index[b]) * (sigma * sigma);
+          }
         }
       }
     }
