@@ -96,8 +96,11 @@ EnergyVectorOptions energyVectorOptions(const RegistrationConfig& config) {
 constexpr int kRefinementIterations = 4;
 constexpr double kRefinementPixels = 3000.0;
 // A refinement that moves the rotation or the zoom by more than this many bins of the log-polar
-// surface did not start within its reach (another layer, a repetitive pattern): not taken.
+// surface did not start within its reach (another layer, a repetitive pattern): not taken unless
+// it fits clearly better, within the motion's window.
 constexpr double kRefinementMaxBins = 2.0;
+// A change of the refinement's loss within this many of its standard errors is the pixels' noise.
+constexpr double kLossEvidence = 2.0;
 // otherLayerShifts: how many peaks, and how near the followed shift a peak is the same layer.
 constexpr int kOtherLayers = 4;
 constexpr double kSameLayerPx = 3.0;
@@ -152,10 +155,19 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
                                                         otherLayerShifts(result, context.polarRadiusStep()));
   const double rotation_bins = std::fabs(refined.similarity.rotation - start.rotation) * n / CV_PI;
   const double zoom_bins = std::fabs(refined.similarity.log_zoom - start.log_zoom) / log_zoom_per_bin;
-  if (!(refined.loss_end >= 0.0 && refined.loss_end <= refined.loss_start) ||
-      !(rotation_bins <= kRefinementMaxBins) ||
-      !(zoom_bins <= kRefinementMaxBins)) {
-    return;
+  // The steps went astray when the fit got worse beyond its noise.
+  const double loss_noise = kLossEvidence * refined.loss_change_sigma;
+  if (!(refined.loss_end >= 0.0) || !(refined.loss_change <= loss_noise)) return;
+  if (!(rotation_bins <= kRefinementMaxBins) || !(zoom_bins <= kRefinementMaxBins)) {
+    // Weak texture leaves the surface's highest peak a few bins off at times; a refinement that
+    // fits clearly better and lands where the motion so far allows corrects it.
+    const bool clearly_better = refined.loss_change < -loss_noise;
+    if (!clearly_better || prior == nullptr ||
+        !(std::fabs(std::remainder(refined.similarity.rotation - prior->rotation, 2.0 * CV_PI)) <=
+          prior->rotation_window) ||
+        !(std::fabs(refined.similarity.log_zoom - prior->log_zoom) <= prior->log_zoom_window)) {
+      return;
+    }
   }
   // A levelled view's stretch is mostly its attitude source's error (a tilt of the whole view,
   // tracked over many pairs); a level camera's, the slope of the surface under this pair.
@@ -168,6 +180,11 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   }
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
+  result.stretch_a = refined.similarity.stretch_a;
+  result.stretch_b = refined.similarity.stretch_b;
+  // A refinement that did not lower the loss still reads the sub-bin zoom the surface cannot,
+  // but its rotation is then no evidence beside the surface's.
+  if (!(refined.loss_change < 0.0)) return;
   result.refined_rotation = refined.similarity.rotation;
   result.refined_rotation_sigma = refined.rotation_sigma;
   if (plane_tilt) {
@@ -180,8 +197,6 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
     const double variance = (gradient.t() * refined.rotation_stretch_covariance * gradient)(0);
     if (variance > 0.0) result.refined_rotation_sigma = std::sqrt(variance);
   }
-  result.stretch_a = refined.similarity.stretch_a;
-  result.stretch_b = refined.similarity.stretch_b;
 }
 
 double confidenceFrom(double psr, double floor, double good) {

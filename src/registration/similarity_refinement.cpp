@@ -125,15 +125,17 @@ double robustScale(std::vector<float>& magnitudes) {
 // the best may do so whatever the motion (where the texture is flat, or near the centre for the
 // zoom), so a scale read at their quartile says little of the fit as a whole; the loss at one
 // scale counts every pixel.
+double tukeyRho(double residual, double limit) {
+  const double u = residual / limit;
+  const double v = u * u < 1.0 ? 1.0 - u * u : 0.0;
+  return 1.0 - v * v * v;
+}
+
 double tukeyLoss(const std::vector<float>& magnitudes, double sigma) {
   if (magnitudes.empty()) return -1.0;
   const double limit = kTukey * sigma;
   double sum = 0.0;
-  for (float m : magnitudes) {
-    const double u = m / limit;
-    const double v = u * u < 1.0 ? 1.0 - u * u : 0.0;
-    sum += 1.0 - v * v * v;
-  }
+  for (float m : magnitudes) sum += tukeyRho(m, limit);
   return sum / magnitudes.size();
 }
 
@@ -239,6 +241,44 @@ double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::ve
   }
   if (count != nullptr) *count = static_cast<int>(scratch.size());
   return robustScale(scratch);
+}
+
+struct LossChange {
+  bool valid = false;
+  double mean = 0.0;
+  double sigma = 0.0;  // standard error of the mean
+};
+
+// The change of the biweight loss (at `sigma`) from motion `a` to motion `b` over the pixels of
+// the sparse grid inside both frames at both, and its standard error: the pixels are paired, so
+// the texture's own spread of the loss cancels and what is left is the change's noise.
+LossChange lossChange(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+                      const BlockMask& blocks, const ImageSimilarity& a, double gain_a, double bias_a,
+                      const ImageSimilarity& b, double gain_b, double bias_b, int stride, double sigma) {
+  const int n = newer.rows;
+  const InverseMap map_a(a, n), map_b(b, n);
+  const double limit = kTukey * sigma;
+  double sum = 0.0, sum2 = 0.0;
+  int count = 0;
+  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
+    if (!(taper[y] > 0.0f)) continue;
+    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
+      if (!(taper[x] > 0.0f) || !blocks.kept(x, y)) continue;
+      const PixelResidual pa = residualAt(older, newer, map_a, gain_a, bias_a, x, y);
+      const PixelResidual pb = residualAt(older, newer, map_b, gain_b, bias_b, x, y);
+      if (!pa.inside || !pb.inside) continue;
+      const double d = tukeyRho(pb.r, limit) - tukeyRho(pa.r, limit);
+      sum += d;
+      sum2 += d * d;
+      ++count;
+    }
+  }
+  LossChange change;
+  if (count < kSimilarityParameters * 10) return change;  // as robustScale
+  change.mean = sum / count;
+  change.sigma = std::sqrt(std::max(sum2 / count - change.mean * change.mean, 0.0) / (count - 1));
+  change.valid = true;
+  return change;
 }
 
 // Variance of the noise of the symmetric gradient (refineSimilarity's PixelResidual) when the
@@ -363,6 +403,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   // The exposure's offset on the steps' grid: on the sparser one its estimate is noisy enough to
   // move the first step's robust weights on frames without any.
   double bias = exposureOffset(older.smooth, newer.smooth, taper, start, stride, scratch);
+  const double bias_start = bias;
   // The blocks are chosen at the start: after a step, which fits the layers' compromise, the other
   // layers' shifts fit the blocks less well than the start's did.
   const BlockMask blocks = followedLayerBlocks(older.smooth, newer.smooth, taper, start, other_layers, bias, stride);
@@ -455,6 +496,12 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   out.residual_end = robustSigma(older.smooth, newer.smooth, taper, blocks, current, gain, bias, sparse, scratch, &out.pixels);
   out.similarity = current;
   if (out.residual_end >= 0.0) out.loss_end = tukeyLoss(scratch, sigma_start);
+  const LossChange change = lossChange(older.smooth, newer.smooth, taper, blocks, start, 1.0, bias_start, current,
+                                       gain, bias, sparse, sigma_start);
+  if (change.valid) {
+    out.loss_change = change.mean;
+    out.loss_change_sigma = change.sigma;
+  }
   return out;
 }
 

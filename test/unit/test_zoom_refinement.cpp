@@ -242,6 +242,37 @@ TEST(ZoomRefinement, KnownSensorNoiseDoesNotShortenTheSteps) {
   EXPECT_GT(worst_unknown, 2.0 * worst_known);  // the premise
 }
 
+TEST(ZoomRefinement, TheLossChangeTellsABetterFitFromTheNoise) {
+  // Weak texture under sensor noise. From a start half a bin off in zoom and one and a half in
+  // rotation the fit improves far beyond the paired change's standard error; from the true
+  // motion the steps only fit the noise, and the loss's change stays within a few of its
+  // standard errors.
+  const double per_bin = logZoomPerBin();
+  const SeparableWindow window(kN, RegistrationConfig{}.taper_fraction);
+  const int stride = static_cast<int>(std::lround(kN / std::sqrt(3000.0)));
+  const sim::ViewMotion motion = motionOf(0.4, 0.0, per_bin);
+  const double variance = (5.0 / 255.0) * (5.0 / 255.0);
+  for (unsigned seed : {21u, 22u, 23u}) {
+    test::ImagePair pair = test::warpedPair(motion, kN, seed);
+    cv::Mat1f older = pair.older, newer = pair.newer;
+    weakAndNoisy(older, newer, seed);
+    const RefinementImage a = makeRefinementImage(older, variance);
+    const RefinementImage b = makeRefinementImage(newer, variance);
+    ImageSimilarity truth;
+    truth.translation = motion.shift;
+    truth.log_zoom = std::log(motion.zoom);
+    ImageSimilarity off = truth;
+    off.log_zoom -= 0.5 * per_bin;
+    off.rotation += 1.5 * CV_PI / kN;
+    const SimilarityRefinement from_off = refineSimilarity(a, b, off, window.taper(), 4, stride);
+    const SimilarityRefinement from_truth = refineSimilarity(a, b, truth, window.taper(), 4, stride);
+    ASSERT_GT(from_off.loss_change_sigma, 0.0) << seed;
+    ASSERT_GT(from_truth.loss_change_sigma, 0.0) << seed;
+    EXPECT_LT(from_off.loss_change, -5.0 * from_off.loss_change_sigma) << seed;
+    EXPECT_LT(std::fabs(from_truth.loss_change), 3.0 * from_truth.loss_change_sigma) << seed;
+  }
+}
+
 TEST(ZoomRefinement, LeavingTheOtherLayersBlocksOutSteadiesAWeakTexturesZoom) {
   // The simulator's default scene (ground and raised tops at 15-30 % of the altitude) in level
   // flight, weak texture (grey std 10) under sensor noise (5 grey levels) and flicker: every

@@ -74,8 +74,9 @@ struct PairRegistration {
   /// content (oefmt/registration/plane_tilt.h; zero otherwise).
   bool zoom_refined = false;
   /// The refinement's own reading of the rotation [rad] and its sigma from the refinement's
-  /// normal equations (SimilarityRefinement::rotation_sigma; 0: none). `rotation` stays the
-  /// surface's: the estimator weighs the two (doc/method.md).
+  /// normal equations (SimilarityRefinement::rotation_sigma; 0: none, also where the refinement
+  /// read the zoom without lowering its loss). `rotation` stays the surface's: the estimator
+  /// weighs the two (doc/method.md).
   double refined_rotation = 0.0;
   double refined_rotation_sigma = 0.0;
   double stretch_a = 0.0;

@@ -45,6 +45,10 @@ struct SimilarityRefinement {
   /// start and at the refined motion (negative: too few pixels): the fit improved when it fell.
   double loss_start = -1.0;
   double loss_end = -1.0;
+  /// The loss's change from the start to the refined motion over the pixels both see at both
+  /// (paired), and the standard error of that mean change (0 when too few pixels took part).
+  double loss_change = 0.0;
+  double loss_change_sigma = 0.0;
   /// Standard deviation of the rotation [rad] the last step solved for, from its normal
   /// equations and the residuals' robust sigma (0: no step was solved). It describes the pixels'
   /// noise, not a model that does not fit (several depth layers): calibrate before use.
