@@ -78,8 +78,7 @@ constexpr double kMaxPairShiftFraction = 0.45;
 
 // Whether a pair's rotation and zoom lie within the prediction's window (true without one).
 bool withinWindow(const PairMotion& motion, const std::optional<RegistrationPrior>& prior) {
-  return !prior || (std::fabs(wrapToPi(motion.rotation - prior->rotation)) <= prior->rotation_window &&
-                    std::fabs(motion.log_zoom - prior->log_zoom) <= prior->log_zoom_window);
+  return !prior || prior->contains(motion.rotation, motion.log_zoom);
 }
 
 struct WindowFrame {

@@ -107,6 +107,11 @@ constexpr double kSameLayerPx = 3.0;
 
 }  // namespace
 
+bool RegistrationPrior::contains(double rotation_rad, double log_zoom_value) const {
+  return std::fabs(wrapAngle(rotation_rad - rotation)) <= rotation_window &&
+         std::fabs(log_zoom_value - log_zoom) <= log_zoom_window;
+}
+
 std::vector<cv::Point2d> otherLayerShifts(const PairRegistration& registration, double shift_per_bin) {
   std::vector<cv::Point2d> shifts;
   const cv::Point2d along(std::cos(registration.direction), std::sin(registration.direction));
@@ -163,9 +168,7 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
     // fits clearly better and lands where the motion so far allows corrects it.
     const bool clearly_better = refined.loss_change < -loss_noise;
     if (!clearly_better || prior == nullptr ||
-        !(std::fabs(std::remainder(refined.similarity.rotation - prior->rotation, 2.0 * CV_PI)) <=
-          prior->rotation_window) ||
-        !(std::fabs(refined.similarity.log_zoom - prior->log_zoom) <= prior->log_zoom_window)) {
+        !prior->contains(refined.similarity.rotation, refined.similarity.log_zoom)) {
       return;
     }
   }
@@ -372,9 +375,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   // taken, however well its translation matched: a repetitive pattern matches itself turned by
   // a quarter, or scaled by its period.
   if (std::fabs(result.rotation) > max_rotation_ ||
-      (prior != nullptr &&
-       (std::fabs(wrapAngle(result.rotation - prior->rotation)) > prior->rotation_window ||
-        std::fabs(std::log(result.zoom) - prior->log_zoom) > prior->log_zoom_window))) {
+      (prior != nullptr && !prior->contains(result.rotation, std::log(result.zoom)))) {
     result.rotation_zoom_implausible = true;
     result.confidence = 0.0;
   }

@@ -120,17 +120,18 @@ double robustScale(std::vector<float>& magnitudes) {
   return 1.4826 * *middle;
 }
 
-// The mean of Tukey's biweight loss (0 for a perfect fit, 1 beyond the threshold) over the
-// absolute residuals `magnitudes` at the scale `sigma`: what the steps lower. The pixels that fit
-// the best may do so whatever the motion (where the texture is flat, or near the centre for the
-// zoom), so a scale read at their quartile says little of the fit as a whole; the loss at one
-// scale counts every pixel.
+// Tukey's biweight loss of one residual at the threshold `limit`: 0 for a perfect fit, 1 beyond.
 double tukeyRho(double residual, double limit) {
   const double u = residual / limit;
   const double v = u * u < 1.0 ? 1.0 - u * u : 0.0;
   return 1.0 - v * v * v;
 }
 
+// The mean of Tukey's biweight loss (0 for a perfect fit, 1 beyond the threshold) over the
+// absolute residuals `magnitudes` at the scale `sigma`: what the steps lower. The pixels that fit
+// the best may do so whatever the motion (where the texture is flat, or near the centre for the
+// zoom), so a scale read at their quartile says little of the fit as a whole; the loss at one
+// scale counts every pixel.
 double tukeyLoss(const std::vector<float>& magnitudes, double sigma) {
   if (magnitudes.empty()) return -1.0;
   const double limit = kTukey * sigma;

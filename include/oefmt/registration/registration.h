@@ -105,6 +105,8 @@ struct RegistrationPrior {
   double log_zoom_sigma = 0.0;   ///< 1-sigma of the prediction [ln s]
   double rotation_window = 0.0;  ///< half width of the window [rad]
   double log_zoom_window = 0.0;  ///< half width of the window [ln s]
+  /// Whether a rotation [rad] and ln zoom lie within the window (a NaN does not).
+  bool contains(double rotation_rad, double log_zoom_value) const;
   /// How closely the motion so far pins the rotation and zoom [rad, ln s]: within the window a
   /// peak's height is weighted by a Gaussian of these widths around the prediction, so that a
   /// nearby peak of another surface (an inclined plane, whose perspective reads as a turn and a
