@@ -115,6 +115,7 @@ struct Estimator::State {
   void clear() {
     f0.reset();
     f1.reset();
+    failed_frame.reset();
     forgetPair01();
     failed = 0;
     anchor.reset();
@@ -147,6 +148,12 @@ struct Estimator::State {
   void anchorFrame(WindowFrame&& frame, bool textured, Estimate& est);
   // The frame could not be registered: predict or hold the pose, maybe restart the window.
   void registrationFailed(WindowFrame&& frame, bool textured, Estimate& est);
+  // The frame did not register against frame 1 after a single failed frame (oefmt mode): where
+  // it registers against the failed frame instead, that frame becomes frame 1 with its predicted
+  // step, est's pair 1-2 and rates_rotation12 are that pair's, and pair 0-2 is dropped: true.
+  bool registerAfterFailedFrame(const WindowFrame& frame, RegistrationMethod method,
+                                const std::optional<std::pair<double, double>>& turn,
+                                RegistrationSurfaces* surfaces, Estimate& est, double& rates_rotation12);
   // Multi-zoom step of the efmt mode; its fused profile goes to next_translation01.
   PairMotion efmtStep(const WindowFrame& frame, Estimate& est,
                       std::vector<float>& next_translation01);
@@ -240,6 +247,10 @@ struct Estimator::State {
 
   int failed = 0;                       // consecutive frames that could not be registered
   std::optional<Pose4> anchor;          // the pose at frame 1 while later frames fail
+  // The last of those frames and the step predicted for it (its pose is the integrator's): the
+  // next frame is also tried against it (see process()).
+  std::optional<WindowFrame> failed_frame;
+  PairMotion failed_step;
   std::optional<PairMotion> last_step;  // the last motion per frame interval
   // The last accepted motions per frame interval, newest last (kept through restarts: the
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
@@ -411,6 +422,7 @@ void Estimator::State::anchorFrame(WindowFrame&& frame, bool textured, Estimate&
 void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Estimate& est) {
   ++failed;
   est.degraded = true;
+  failed_frame.reset();
   if (!anchor) anchor = integrator.pose();
   // The frame that restarts the window is predicted too: the vehicle kept moving while frames
   // failed, and a held pose would drop one step from the trajectory.
@@ -427,6 +439,11 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
     if (failed <= config.tracking.max_failed_frames && textured && f1 &&
         !shiftInReach(last_step->translation * (static_cast<double>(frame.index - f1->index) + 1.0))) {
       slideTo(std::move(frame), predicted);
+      return;
+    }
+    if (failed <= config.tracking.max_failed_frames && textured) {
+      failed_frame = std::move(frame);
+      failed_step = predicted;
       return;
     }
   } else {
@@ -449,6 +466,40 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   } else {
     f1.reset();
   }
+}
+
+bool Estimator::State::registerAfterFailedFrame(const WindowFrame& frame, RegistrationMethod method,
+                                                const std::optional<std::pair<double, double>>& turn,
+                                                RegistrationSurfaces* surfaces, Estimate& est,
+                                                double& rates_rotation12) {
+  // This frame does not register against frame 1, two intervals back. One interval back, the
+  // failed frame may: its view was not the trouble, only its pair with frame 1 (a layer or a
+  // texture that filled that pair's view, a periodic texture's alias that won it). Its pose is
+  // predicted, one interval from a measured one; chained from it, the track keeps that
+  // prediction's error for good, which after more failed frames (a longer prediction, and a
+  // motion model the measurements no longer confirm) would outweigh the frames it saves: then
+  // the window restarts as before.
+  if (config.mode != EstimatorMode::kOefmt || !failed_frame || failed != 1) return false;
+  const double seconds = frame.stamp - failed_frame->stamp;
+  std::optional<RegistrationPrior> prior = predictedPair(1, seconds, nullptr);
+  const double rates_rotation = prior ? prior->rotation : 0.0;
+  if (turn && prior) takeTurn(*prior, -turn->first, turn->second);  // the gyro's, over this interval
+  RegistrationSurfaces retry_surfaces;
+  PairRegistration retry = registrar.registerPair(failed_frame->spectra, frame.spectra, method,
+                                                  surfaces ? &retry_surfaces : nullptr,
+                                                  prior ? &*prior : nullptr, maxRotation(seconds));
+  if (!retry.usable()) return false;
+  if (pending02.valid()) pending02.wait();  // pair 0-2 of the old frame 0
+  pending02 = {};
+  slideTo(std::move(*failed_frame), failed_step);
+  failed_frame.reset();
+  est.frame_gap = static_cast<int>(frame.index - f1->index);
+  prior12 = std::move(prior);
+  rates_rotation12 = rates_rotation;
+  est.prediction12 = prior12;
+  est.registration12 = std::move(retry);
+  if (surfaces) *surfaces = std::move(retry_surfaces);
+  return true;
 }
 
 PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est) {
@@ -684,6 +735,7 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
   have01 = true;
   failed = 0;
   anchor.reset();
+  failed_frame.reset();
   f0 = std::move(f1);
   f1 = std::move(frame);
 }
@@ -876,7 +928,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
                                           : RegistrationMethod::kEnergyVectors;
     const Clock::time_point t = Clock::now();
     const double seconds12 = frame.stamp - s.f1->stamp;
-    const bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
+    bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
                         s.shiftInReach(s.motion01.translation * (double(s.gap01 + est.frame_gap) / s.gap01));
     s.prior02 = with02 ? s.predictedPair(est.frame_gap, seconds12, &s.motion01) : std::nullopt;
     // Levelled frames: the zooms are corrected for the tilt the attitude source left (zero until
@@ -911,7 +963,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
-    const double rates_rotation12 = s.prior12 ? s.prior12->rotation : 0.0;
+    double rates_rotation12 = s.prior12 ? s.prior12->rotation : 0.0;
     if (turn && s.prior12) s.takeTurn(*s.prior12, -turn->first, turn->second);
     est.prediction12 = s.prior12;
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
@@ -930,6 +982,10 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
         est.registration12 = std::move(retry);
         if (surfaces) *surfaces = std::move(still_surfaces);
       }
+    }
+    if (!est.registration12.usable() &&
+        s.registerAfterFailedFrame(frame, method, turn, surfaces, est, rates_rotation12)) {
+      with02 = false;
     }
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {

@@ -252,6 +252,39 @@ TEST(Estimator, UnregistrableFramesArePredictedThenTrackingResumes) {
   EXPECT_LT(relativeEndError(estimates, flight), 0.015);
 }
 
+// The view changes to another scene (another texture under the same flight): the first frame of
+// it matches nothing before it and is predicted; the next one matches nothing two intervals back
+// either, but its predecessor one interval back, from whose predicted pose tracking resumes at
+// once instead of after a restart.
+TEST(Estimator, TheFrameAfterAFailedOneRegistersAgainstIt) {
+  const std::vector<test::CameraState> track = test::straightLine(11, 5.0, 3.0);
+  const test::Flight first = test::renderFlight(test::flightTexture(), track, kN);
+  const cv::Mat1f other_scene =
+      sim::proceduralTexture(test::flightTexture().size(), 57, sim::TextureStyle::kCells, 40.0);
+  const test::Flight second = test::renderFlight(other_scene, track, kN);
+  Estimator estimator(flightConfig());
+  std::vector<Estimate> estimates;
+  for (std::size_t k = 0; k < track.size(); ++k) {
+    std::optional<Estimate> e = estimator.push(k < 6 ? first.frames[k] : second.frames[k], static_cast<double>(k));
+    ASSERT_TRUE(e.has_value());
+    estimates.push_back(*e);
+  }
+  expectFinite(estimates);
+  EXPECT_EQ(estimates[6].state, TrackingState::kPredicted);
+  for (std::size_t k = 7; k < estimates.size(); ++k) {
+    EXPECT_EQ(estimates[k].state, TrackingState::kTracking) << "frame " << k;
+    EXPECT_EQ(estimates[k].frame_gap, 1) << "frame " << k;
+  }
+  // The steps after the change are measured: each within 3 % of the true one.
+  for (std::size_t k = 7; k < estimates.size(); ++k) {
+    const double dx = estimates[k].pose.x - estimates[k - 1].pose.x;
+    const double dy = estimates[k].pose.y - estimates[k - 1].pose.y;
+    const double tx = track[k].east - track[k - 1].east, ty = track[k].north - track[k - 1].north;
+    EXPECT_LT(std::hypot(dx - tx, dy - ty), 0.03 * std::hypot(tx, ty)) << "frame " << k;
+  }
+  EXPECT_LT(relativeEndError(estimates, first), 0.02);
+}
+
 TEST(Estimator, LongFailuresRestartTheWindow) {
   const test::Flight flight =
       test::renderFlight(test::flightTexture(), test::straightLine(6, 4.0, 0.0), kN);
