@@ -116,6 +116,7 @@ struct Estimator::State {
     f0.reset();
     f1.reset();
     failed_frame.reset();
+    turn_since_f1 = std::make_pair(0.0, 0.0);
     forgetPair01();
     failed = 0;
     anchor.reset();
@@ -251,6 +252,9 @@ struct Estimator::State {
   // next frame is also tried against it (see process()).
   std::optional<WindowFrame> failed_frame;
   PairMotion failed_step;
+  // The gyro's turn from frame 1 to the last frame pushed [rad] and its sigma (the frames between
+  // failed): none where one of them came without a turn.
+  std::optional<std::pair<double, double>> turn_since_f1 = std::make_pair(0.0, 0.0);
   std::optional<PairMotion> last_step;  // the last motion per frame interval
   // The last accepted motions per frame interval, newest last (kept through restarts: the
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
@@ -942,10 +946,16 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     s.registrar.setPlaneTilt(plane_tilt);
     s.registrar02.setPlaneTilt(plane_tilt);
     if (plane_tilt) est.plane_tilt = *plane_tilt * config_.effectiveFx();
-    // A gyro's turn stands for the predicted rotation (the image turns against the camera).
-    if (turn && s.prior02) {
-      s.takeTurn(*s.prior02, s.motion01.rotation - turn->first,
-                 std::hypot(turn->second, s.motion01.rotation_sigma));
+    // A gyro's turn stands for the predicted rotation (the image turns against the camera). Its
+    // turn spans the last interval; after failed frames, pair 1-2 spans theirs too. A gyro's error
+    // is mostly its bias: the intervals' sigmas add.
+    const std::optional<std::pair<double, double>> turn12 =
+        turn && s.turn_since_f1 ? std::make_optional(std::make_pair(s.turn_since_f1->first + turn->first,
+                                                                    s.turn_since_f1->second + turn->second))
+                                : std::nullopt;
+    if (turn12 && s.prior02) {
+      s.takeTurn(*s.prior02, s.motion01.rotation - turn12->first,
+                 std::hypot(turn12->second, s.motion01.rotation_sigma));
     }
     if (with02 && config_.parallel_registrations) {
       // Pair 0-2 on a second thread while this one registers 1-2 (both read the frames'
@@ -964,7 +974,8 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
     double rates_rotation12 = s.prior12 ? s.prior12->rotation : 0.0;
-    if (turn && s.prior12) s.takeTurn(*s.prior12, -turn->first, turn->second);
+    if (turn12 && s.prior12) s.takeTurn(*s.prior12, -turn12->first, turn12->second);
+    bool gyro_turn12 = turn12.has_value();
     est.prediction12 = s.prior12;
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
                                                   s.prior12 ? &*s.prior12 : nullptr,
@@ -986,6 +997,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     if (!est.registration12.usable() &&
         s.registerAfterFailedFrame(frame, method, turn, surfaces, est, rates_rotation12)) {
       with02 = false;
+      gyro_turn12 = turn.has_value();
     }
     est.registration_ms += msSince(t);
     if (!est.registration12.usable()) {
@@ -1012,11 +1024,13 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       }
       if (config_.mode == EstimatorMode::kOefmt) {
         step = s.consistentRates(s.plausibleStep(s.vouchedStep(step, est), est), rates_rotation12,
-                                turn.has_value(), est);
+                                gyro_turn12, est);
       }
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }
+    s.turn_since_f1 = turn12;  // unless this frame became frame 1 (below), the next pair spans it
   }
+  if (!s.f1 || s.f1->index == est.frame_index) s.turn_since_f1 = std::make_pair(0.0, 0.0);
   est.pose = s.integrator.pose();
   if (est.state != TrackingState::kStarted) est.step_covariance = s.integrator.lastStepCovariance();
   est.total_ms = prepare_ms + msSince(start);

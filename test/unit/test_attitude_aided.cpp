@@ -8,6 +8,9 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "oefmt/estimation/attitude.h"
 #include "oefmt/estimation/estimator.h"
@@ -172,6 +175,56 @@ TEST(Attitude, TurnHistoryIntegratesTheYawRateNotTheVerticalRate) {
   gap.add(0.0, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   gap.add(0.5, Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   EXPECT_FALSE(gap.turn(0.1, 0.2).has_value());  // nothing is known inside a gap
+}
+
+// The same sudden yaw, in the interval of a frame that fails (the camera saw something else): the
+// next frame is registered against the one before the failure, two intervals back, and the gyro's
+// turn over both intervals (the yaw, and none) is where its rotation is searched. Taking only the
+// last interval's turn (none), the yaw was refused and tracking resumed only after a restart.
+TEST(AttitudeAidedRegistration, AfterAFailedFrameTheGyrosTurnSpansBothIntervals) {
+  constexpr int kN = 256;
+  constexpr int kTurnFrame = 8;
+  constexpr double kTurn = 25.0 * kDeg;
+  sim::FlightOptions options;
+  options.width = options.height = kN;
+  options.flat = true;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.frames = 12;
+  options.track.length = 12.0;
+  options.track.altitude = 12.0;
+  options.seed = 4;
+  sim::FlightPlan plan = sim::planFlight(options);
+  for (int k = kTurnFrame; k < static_cast<int>(plan.poses.size()); ++k) plan.poses[k].yaw += kTurn;
+  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
+  const sim::Renderer renderer(scene, plan.camera, 2);
+  cv::Mat1f unrelated(kN, kN);
+  cv::RNG(7).fill(unrelated, cv::RNG::UNIFORM, 0.0f, 1.0f);
+  cv::GaussianBlur(unrelated, unrelated, cv::Size(0, 0), 3.0);
+
+  EstimatorConfig config;
+  config.registration.size = kN;
+  config.registration.fft_planning = FftPlanning::kEstimate;
+  config.working_fx = plan.camera.intrinsics.fx;
+  Estimator estimator(config);
+  std::vector<Estimate> estimates;
+  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
+    if (k > 0) estimator.setTurn(plan.poses[k].yaw - plan.poses[k - 1].yaw, kGyroRateError * 0.2);
+    const cv::Mat1f frame = static_cast<int>(k) == kTurnFrame ? unrelated : renderer.render(plan.poses[k]).image;
+    const std::optional<Estimate> e = estimator.push(frame, 0.2 * static_cast<double>(k));
+    ASSERT_TRUE(e.has_value());
+    estimates.push_back(*e);
+  }
+  EXPECT_EQ(estimates[kTurnFrame].state, TrackingState::kPredicted);
+  const Estimate& next = estimates[kTurnFrame + 1];
+  EXPECT_EQ(next.state, TrackingState::kTracking);
+  EXPECT_EQ(next.frame_gap, 2);
+  EXPECT_NEAR(std::fabs(next.registration12.rotation), kTurn, 0.5 * kDeg);
+  // The heading after the gap is the truth's.
+  const double yaw_change = std::remainder(next.pose.yaw - estimates[kTurnFrame - 1].pose.yaw, 2.0 * M_PI);
+  EXPECT_NEAR(std::fabs(yaw_change), kTurn, 0.5 * kDeg);
+  for (std::size_t k = kTurnFrame + 2; k < estimates.size(); ++k) {
+    EXPECT_EQ(estimates[k].state, TrackingState::kTracking) << k;
+  }
 }
 
 TEST(AttitudeAidedRegistration, AGyrosTurnLetsASuddenYawRegister) {
