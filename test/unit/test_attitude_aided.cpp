@@ -177,14 +177,22 @@ TEST(Attitude, TurnHistoryIntegratesTheYawRateNotTheVerticalRate) {
   EXPECT_FALSE(gap.turn(0.1, 0.2).has_value());  // nothing is known inside a gap
 }
 
-// The same sudden yaw, in the interval of a frame that fails (the camera saw something else): the
-// next frame is registered against the one before the failure, two intervals back, and the gyro's
-// turn over both intervals (the yaw, and none) is where its rotation is searched. Taking only the
-// last interval's turn (none), the yaw was refused and tracking resumed only after a restart.
-TEST(AttitudeAidedRegistration, AfterAFailedFrameTheGyrosTurnSpansBothIntervals) {
-  constexpr int kN = 256;
-  constexpr int kTurnFrame = 8;
-  constexpr double kTurn = 25.0 * kDeg;
+// A straight flight over flat ground whose camera yaws kTurn between frames kTurnFrame - 1 and
+// kTurnFrame (125 deg/s at its 5 frames per second), rendered at kN, and the estimator's
+// configuration for it.
+constexpr int kN = 256;
+constexpr int kTurnFrame = 8;
+constexpr double kTurn = 25.0 * kDeg;
+constexpr double kFrameInterval = 0.2;  // [s]
+
+struct SuddenYawFlight {
+  sim::FlightPlan plan;
+  std::vector<cv::Mat1f> frames;
+  EstimatorConfig config;
+};
+
+SuddenYawFlight suddenYawFlight() {
+  SuddenYawFlight flight;
   sim::FlightOptions options;
   options.width = options.height = kN;
   options.flat = true;
@@ -193,76 +201,36 @@ TEST(AttitudeAidedRegistration, AfterAFailedFrameTheGyrosTurnSpansBothIntervals)
   options.track.length = 12.0;
   options.track.altitude = 12.0;
   options.seed = 4;
-  sim::FlightPlan plan = sim::planFlight(options);
-  for (int k = kTurnFrame; k < static_cast<int>(plan.poses.size()); ++k) plan.poses[k].yaw += kTurn;
-  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
-  const sim::Renderer renderer(scene, plan.camera, 2);
-  cv::Mat1f unrelated(kN, kN);
-  cv::RNG(7).fill(unrelated, cv::RNG::UNIFORM, 0.0f, 1.0f);
-  cv::GaussianBlur(unrelated, unrelated, cv::Size(0, 0), 3.0);
-
-  EstimatorConfig config;
-  config.registration.size = kN;
-  config.registration.fft_planning = FftPlanning::kEstimate;
-  config.working_fx = plan.camera.intrinsics.fx;
-  Estimator estimator(config);
-  std::vector<Estimate> estimates;
-  for (std::size_t k = 0; k < plan.poses.size(); ++k) {
-    if (k > 0) estimator.setTurn(plan.poses[k].yaw - plan.poses[k - 1].yaw, kGyroRateError * 0.2);
-    const cv::Mat1f frame = static_cast<int>(k) == kTurnFrame ? unrelated : renderer.render(plan.poses[k]).image;
-    const std::optional<Estimate> e = estimator.push(frame, 0.2 * static_cast<double>(k));
-    ASSERT_TRUE(e.has_value());
-    estimates.push_back(*e);
-  }
-  EXPECT_EQ(estimates[kTurnFrame].state, TrackingState::kPredicted);
-  const Estimate& next = estimates[kTurnFrame + 1];
-  EXPECT_EQ(next.state, TrackingState::kTracking);
-  EXPECT_EQ(next.frame_gap, 2);
-  EXPECT_NEAR(std::fabs(next.registration12.rotation), kTurn, 0.5 * kDeg);
-  // The heading after the gap is the truth's.
-  const double yaw_change = std::remainder(next.pose.yaw - estimates[kTurnFrame - 1].pose.yaw, 2.0 * M_PI);
-  EXPECT_NEAR(std::fabs(yaw_change), kTurn, 0.5 * kDeg);
-  for (std::size_t k = kTurnFrame + 2; k < estimates.size(); ++k) {
-    EXPECT_EQ(estimates[k].state, TrackingState::kTracking) << k;
-  }
+  flight.plan = sim::planFlight(options);
+  std::vector<sim::FlightPose>& poses = flight.plan.poses;
+  for (int k = kTurnFrame; k < static_cast<int>(poses.size()); ++k) poses[k].yaw += kTurn;
+  const auto scene = std::make_shared<const sim::Scene>(flight.plan.scene);
+  const sim::Renderer renderer(scene, flight.plan.camera, 2);
+  for (const sim::FlightPose& pose : poses) flight.frames.push_back(renderer.render(pose).image);
+  flight.config.registration.size = kN;
+  flight.config.registration.fft_planning = FftPlanning::kEstimate;
+  flight.config.working_fx = flight.plan.camera.intrinsics.fx;
+  return flight;
 }
 
 TEST(AttitudeAidedRegistration, AGyrosTurnLetsASuddenYawRegister) {
   // A vehicle flies straight, then yaws 25 degrees between two frames (125 deg/s). The motion so
   // far predicts no turn and searches the rotation near it: the turn is refused as implausible.
   // With the gyro's turn the rotation is searched where it is, and the frame registers.
-  constexpr int kN = 256;
-  constexpr int kTurnFrame = 8;
-  constexpr double kTurn = 25.0 * kDeg;
-  sim::FlightOptions options;
-  options.width = options.height = kN;
-  options.flat = true;
-  options.track.shape = sim::TrackShape::kLine;
-  options.track.frames = 12;
-  options.track.length = 12.0;
-  options.track.altitude = 12.0;
-  options.seed = 4;
-  sim::FlightPlan plan = sim::planFlight(options);
-  for (int k = kTurnFrame; k < static_cast<int>(plan.poses.size()); ++k) plan.poses[k].yaw += kTurn;
-  const auto scene = std::make_shared<const sim::Scene>(plan.scene);
-  const sim::Renderer renderer(scene, plan.camera, 2);
-  std::vector<cv::Mat1f> frames;
-  for (const sim::FlightPose& pose : plan.poses) frames.push_back(renderer.render(pose).image);
+  const SuddenYawFlight flight = suddenYawFlight();
+  const sim::FlightPlan& plan = flight.plan;
+  const std::vector<cv::Mat1f>& frames = flight.frames;
 
   const auto fly = [&](bool gyro) {
-    EstimatorConfig config;
-    config.registration.size = kN;
-    config.registration.fft_planning = FftPlanning::kEstimate;
-    config.working_fx = plan.camera.intrinsics.fx;
-    Estimator estimator(config);
+    Estimator estimator(flight.config);
     std::vector<Estimate> estimates;
     for (std::size_t k = 0; k < frames.size(); ++k) {
       if (gyro && k > 0) {
         // A gyro whose turn is 1 degree short at the sudden yaw.
         const double turn = plan.poses[k].yaw - plan.poses[k - 1].yaw;
-        estimator.setTurn(static_cast<int>(k) == kTurnFrame ? turn - 1.0 * kDeg : turn, kGyroRateError * 0.2);
+        estimator.setTurn(static_cast<int>(k) == kTurnFrame ? turn - 1.0 * kDeg : turn, kGyroRateError * kFrameInterval);
       }
-      const std::optional<Estimate> e = estimator.push(frames[k], 0.2 * static_cast<double>(k));
+      const std::optional<Estimate> e = estimator.push(frames[k], kFrameInterval * static_cast<double>(k));
       EXPECT_TRUE(e.has_value());
       if (e) estimates.push_back(*e);
     }
@@ -290,6 +258,38 @@ TEST(AttitudeAidedRegistration, AGyrosTurnLetsASuddenYawRegister) {
   // The image's rotation is measured, not copied from the gyro: the turn the gyro got 1 degree
   // short registers at the true one (the window holds both).
   EXPECT_NEAR(std::fabs(with[kTurnFrame].registration12.rotation), kTurn, 0.5 * kDeg);
+}
+
+// The same sudden yaw, in the interval of a frame that fails (the camera saw something else): the
+// next frame is registered against the one before the failure, two intervals back, and the gyro's
+// turn over both intervals (the yaw, and none) is where its rotation is searched. Taking only the
+// last interval's turn (none), the yaw was refused and tracking resumed only after a restart.
+TEST(AttitudeAidedRegistration, AfterAFailedFrameTheGyrosTurnSpansBothIntervals) {
+  const SuddenYawFlight flight = suddenYawFlight();
+  const std::vector<sim::FlightPose>& poses = flight.plan.poses;
+  cv::Mat1f unrelated(kN, kN);
+  cv::RNG(7).fill(unrelated, cv::RNG::UNIFORM, 0.0f, 1.0f);
+  cv::GaussianBlur(unrelated, unrelated, cv::Size(0, 0), 3.0);
+  Estimator estimator(flight.config);
+  std::vector<Estimate> estimates;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    if (k > 0) estimator.setTurn(poses[k].yaw - poses[k - 1].yaw, kGyroRateError * kFrameInterval);
+    const cv::Mat1f& frame = static_cast<int>(k) == kTurnFrame ? unrelated : flight.frames[k];
+    const std::optional<Estimate> e = estimator.push(frame, kFrameInterval * static_cast<double>(k));
+    ASSERT_TRUE(e.has_value());
+    estimates.push_back(*e);
+  }
+  EXPECT_EQ(estimates[kTurnFrame].state, TrackingState::kPredicted);
+  const Estimate& next = estimates[kTurnFrame + 1];
+  EXPECT_EQ(next.state, TrackingState::kTracking);
+  EXPECT_EQ(next.frame_gap, 2);
+  EXPECT_NEAR(std::fabs(next.registration12.rotation), kTurn, 0.5 * kDeg);
+  // The heading after the gap is the truth's.
+  const double yaw_change = std::remainder(next.pose.yaw - estimates[kTurnFrame - 1].pose.yaw, 2.0 * M_PI);
+  EXPECT_NEAR(std::fabs(yaw_change), kTurn, 0.5 * kDeg);
+  for (std::size_t k = kTurnFrame + 2; k < estimates.size(); ++k) {
+    EXPECT_EQ(estimates[k].state, TrackingState::kTracking) << k;
+  }
 }
 
 }  // namespace
