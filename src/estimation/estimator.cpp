@@ -248,8 +248,8 @@ struct Estimator::State {
 
   int failed = 0;                       // consecutive frames that could not be registered
   std::optional<Pose4> anchor;          // the pose at frame 1 while later frames fail
-  // The last of those frames and the step predicted for it (its pose is the integrator's): the
-  // next frame is also tried against it (see process()).
+  // The first of those frames, while it is the only one, and the step predicted for it (its pose
+  // is the integrator's): the next frame is also tried against it (registerAfterFailedFrame).
   std::optional<WindowFrame> failed_frame;
   PairMotion failed_step;
   // The gyro's turn from frame 1 to the last frame pushed [rad] and its sigma (the frames between
@@ -445,7 +445,7 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
       slideTo(std::move(frame), predicted);
       return;
     }
-    if (failed <= config.tracking.max_failed_frames && textured) {
+    if (failed == 1 && failed <= config.tracking.max_failed_frames && textured) {
       failed_frame = std::move(frame);
       failed_step = predicted;
       return;
@@ -483,7 +483,7 @@ bool Estimator::State::registerAfterFailedFrame(const WindowFrame& frame, Regist
   // prediction's error for good, which after more failed frames (a longer prediction, and a
   // motion model the measurements no longer confirm) would outweigh the frames it saves: then
   // the window restarts as before.
-  if (config.mode != EstimatorMode::kOefmt || !failed_frame || failed != 1) return false;
+  if (config.mode != EstimatorMode::kOefmt || !failed_frame) return false;
   const double seconds = frame.stamp - failed_frame->stamp;
   std::optional<RegistrationPrior> prior = predictedPair(1, seconds, nullptr);
   const double rates_rotation = prior ? prior->rotation : 0.0;

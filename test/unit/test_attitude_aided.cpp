@@ -228,7 +228,8 @@ TEST(AttitudeAidedRegistration, AGyrosTurnLetsASuddenYawRegister) {
       if (gyro && k > 0) {
         // A gyro whose turn is 1 degree short at the sudden yaw.
         const double turn = plan.poses[k].yaw - plan.poses[k - 1].yaw;
-        estimator.setTurn(static_cast<int>(k) == kTurnFrame ? turn - 1.0 * kDeg : turn, kGyroRateError * kFrameInterval);
+        estimator.setTurn(static_cast<int>(k) == kTurnFrame ? turn - 1.0 * kDeg : turn,
+                          kGyroRateError * kFrameInterval);
       }
       const std::optional<Estimate> e = estimator.push(frames[k], kFrameInterval * static_cast<double>(k));
       EXPECT_TRUE(e.has_value());

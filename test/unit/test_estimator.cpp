@@ -265,7 +265,8 @@ TEST(Estimator, TheFrameAfterAFailedOneRegistersAgainstIt) {
   Estimator estimator(flightConfig());
   std::vector<Estimate> estimates;
   for (std::size_t k = 0; k < track.size(); ++k) {
-    std::optional<Estimate> e = estimator.push(k < 6 ? first.frames[k] : second.frames[k], static_cast<double>(k));
+    const cv::Mat1f& frame = k < 6 ? first.frames[k] : second.frames[k];
+    std::optional<Estimate> e = estimator.push(frame, static_cast<double>(k));
     ASSERT_TRUE(e.has_value());
     estimates.push_back(*e);
   }
