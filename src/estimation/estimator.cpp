@@ -127,6 +127,7 @@ struct Estimator::State {
     levelled = false;
     implausible_steps = 0;
     unconfirmed_steps = 0;
+    ambiguous_motion = false;
     started = false;
     last_stamp = -std::numeric_limits<double>::infinity();
   }
@@ -268,6 +269,9 @@ struct Estimator::State {
   // The followed layer's length against the layers in view over the last measured steps.
   LayerRatioMemory layer_ratios{kLayerRatioFrames, kLayerRatioSupport, kLayerRatioTolerance};
   int unconfirmed_steps = 0;  // steps in a row that did not enter recent_steps
+  // The translations since the last start rest on a reading that a rival peak matched as well
+  // (RegistrationPrior::translation_ambiguous).
+  bool ambiguous_motion = false;
   bool started = false;
   double last_stamp = -std::numeric_limits<double>::infinity();
 
@@ -777,7 +781,7 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
   // the ratios hold, within 2 % of the predicted length itself).
   const PairRegistration& r = est.registration12;
   if (!have01 || !prior12 || !(prior12->translation_radius > 0.0) ||
-      r.status != RegistrationStatus::kLowConfidence || !(r.confidence > 0.0) ||
+      r.status != RegistrationStatus::kLowConfidence || !(r.peak_confidence > 0.0) ||
       r.rotation_zoom_implausible || !(r.shift > 0.0)) {
     return std::nullopt;
   }
@@ -973,6 +977,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
+    if (s.prior12) s.prior12->translation_ambiguous = s.ambiguous_motion;
     double rates_rotation12 = s.prior12 ? s.prior12->rotation : 0.0;
     if (turn12 && s.prior12) s.takeTurn(*s.prior12, -turn12->first, turn12->second);
     bool gyro_turn12 = turn12.has_value();
@@ -989,7 +994,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       PairRegistration retry = s.registrar.registerPair(s.f1->spectra, frame.spectra, method,
                                                         surfaces ? &still_surfaces : nullptr, &still,
                                                         s.maxRotation(seconds12));
-      if (retry.confidence > est.registration12.confidence) {
+      if (retry.peak_confidence > est.registration12.peak_confidence) {
         est.registration12 = std::move(retry);
         if (surfaces) *surfaces = std::move(still_surfaces);
       }
@@ -1014,6 +1019,25 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
         s.registrationFailed(std::move(frame), textured, est);
       }
     } else {
+      if (est.registration12.translation_unrivalled) {
+        s.ambiguous_motion = false;
+        if (s.prior12 && cv::norm(est.registration12.translation - s.prior12->translation) >
+                             s.prior12->translation_radius) {
+          // The motion so far followed a periodic texture's alias: the window starts over from
+          // frame 1 with this pair, as after a restart (the poses before stay as integrated).
+          if (s.pending02.valid()) s.pending02.wait();
+          s.pending02 = {};
+          with02 = false;
+          s.f0.reset();
+          s.forgetPair01();
+          s.recent_steps.clear();
+          s.implausible_steps = 0;
+          s.prior12.reset();
+          est.alias_left = true;
+        }
+      } else if (!(est.prediction12 && est.prediction12->translation_radius > 0.0)) {
+        s.ambiguous_motion = est.registration12.uniqueness() < 1.0;
+      }
       est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
       std::vector<float> next_translation01 = est.registration12.translation_energy;
       PairMotion step = est.measured12;

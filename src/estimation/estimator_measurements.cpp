@@ -144,6 +144,15 @@ PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
                                        kMinShiftSigma)
                             : along;
   m.translation_covariance = alongAcrossCovariance(m.direction(), along, across);
+  // A rival peak as high (a periodic texture's alias, or the motion where the taken peak is the
+  // alias) makes the reading one of two: the covariance of that mixture, the rival weighing up
+  // to a half as it reaches the taken peak's height.
+  const double rival_weight = 0.5 * (1.0 - r.uniqueness());
+  if (rival_weight > 0.0) {
+    const cv::Vec2d apart(finiteOr(r.rival_translation.x - r.translation.x, 0.0),
+                          finiteOr(r.rival_translation.y - r.translation.y, 0.0));
+    m.translation_covariance += rival_weight * (1.0 - rival_weight) * (apart * apart.t());
+  }
   return m;
 }
 

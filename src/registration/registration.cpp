@@ -214,7 +214,17 @@ Registrar::Registrar(const RegistrationConfig& config)
 Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
     : context_(std::move(context)),
       builder_(context_),
-      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {}
+      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {
+  // A match's correlation peak grows with the windowed energy the two frames share at its shift.
+  const std::vector<float>& taper = context_->window().taper();
+  const int n = static_cast<int>(taper.size());
+  overlap_share_.assign(static_cast<size_t>(n), 0.0);
+  for (int shift = 0; shift < n; ++shift) {
+    for (int i = 0; i + shift < n; ++i) overlap_share_[shift] += double(taper[i]) * taper[i + shift];
+  }
+  const double whole = overlap_share_.empty() ? 0.0 : overlap_share_[0];
+  for (double& share : overlap_share_) share = whole > 0.0 ? share / whole : 0.0;
+}
 
 FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {
   return builder_.build(image, order);
@@ -263,7 +273,7 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
       PairRegistration trial;
       RegistrationSurfaces trial_surfaces;
       registerOnce(older, newer, method, trial, peak, surfaces ? &trial_surfaces : nullptr, nullptr);
-      if (attempt == 0 || trial.confidence > result.confidence) {
+      if (attempt == 0 || trial.peak_confidence > result.peak_confidence) {
         result = std::move(trial);
         result.rotation_zoom_candidate = attempt;
         if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
@@ -275,7 +285,7 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     PairRegistration trial;
     RegistrationSurfaces trial_surfaces;
     registerOnPrior(older, newer, method, *prior, trial, surfaces ? &trial_surfaces : nullptr);
-    if (trial.confidence > result.confidence) {
+    if (trial.peak_confidence > result.peak_confidence) {
       result = std::move(trial);
       if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
     }
@@ -337,7 +347,7 @@ PairRegistration Registrar::registerInWindow(const FrameSpectra& older, const Fr
   registerOnce(older, newer, method, trial, second, surfaces ? &trial_surfaces : nullptr, &prior);
   const bool better = registered ? trial.status == RegistrationStatus::kOk &&
                                        trial.followed_confidence > result.followed_confidence
-                                 : trial.confidence > result.confidence;
+                                 : trial.peak_confidence > result.peak_confidence;
   if (better) {
     result = std::move(trial);
     result.rotation_zoom_candidate = 1;
@@ -367,7 +377,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
         method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
     surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
   }
-  result.confidence =
+  result.peak_confidence =
       std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
                translation_confidence);
   // A rotation beyond the vehicle's reach, or a rotation or zoom the motion so far rules out
@@ -377,9 +387,10 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   if (std::fabs(result.rotation) > max_rotation_ ||
       (prior != nullptr && !prior->contains(result.rotation, std::log(result.zoom)))) {
     result.rotation_zoom_implausible = true;
-    result.confidence = 0.0;
+    result.peak_confidence = 0.0;
   }
-  result.status = result.confidence >= context_->config().min_confidence
+  result.confidence = result.peak_confidence * result.uniqueness();
+  result.status = result.peak_confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
   if (result.status == RegistrationStatus::kOk && context_->config().refine_zoom) {
@@ -420,8 +431,9 @@ void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& n
     surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
   }
   // Nothing was measured of the rotation and zoom: the translation alone says whether they fit.
-  result.confidence = translation_confidence;
-  result.status = result.confidence >= context_->config().min_confidence
+  result.peak_confidence = translation_confidence;
+  result.confidence = result.peak_confidence * result.uniqueness();
+  result.status = result.peak_confidence >= context_->config().min_confidence
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
 }
@@ -567,7 +579,17 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   result.translation_from_window = false;
   result.translation_implausible = false;
   result.followed_confidence = 0.0;
-  if (prior == nullptr || !(prior->translation_radius > 0.0)) return global;
+  result.rival_ratio = 0.0;
+  const double count = static_cast<double>(surface_.total());
+  const double mean = stats.abs_sum / count;
+  const double deviation = std::sqrt(std::max(stats.square_sum / count - mean * mean, 0.0));
+  // A rival must be a peak that could register the pair by itself.
+  const auto floor = [&](double psr) { return static_cast<float>(mean + psr * deviation); };
+  result.translation_unrivalled = false;
+  if (prior == nullptr || !(prior->translation_radius > 0.0)) {
+    findRival(peak, floor(kTranslationPsrFloor), result);
+    return global;
+  }
 
   const double radius = std::min(prior->translation_radius, 0.25 * n);
   const cv::Point2d predicted = prior->translation;
@@ -582,16 +604,26 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   const double cells = (2.0 * half + 1.0) * (2.0 * half + 1.0);
   const double shrink = std::log(cells) / std::log(static_cast<double>(n) * n);
   // Values below half that floor could not make a peak of any confidence: not searched.
-  const double count = static_cast<double>(surface_.total());
-  const double mean = stats.abs_sum / count;
-  const double deviation = std::sqrt(std::max(stats.square_sum / count - mean * mean, 0.0));
-  const float noise_level = static_cast<float>(mean + 0.5 * kTranslationPsrFloor * shrink * deviation);
-  const SurfacePeak near = findPeakInWindow(
-      surface_, cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
-                          static_cast<int>(std::lround(n / 2 + predicted.y))),
-      half, half, true, shape, cv::Point2d(radius / 3.0, radius / 3.0), cv::Point(-10, -10), noise_level);
+  const float noise_level = floor(0.5 * kTranslationPsrFloor * shrink);
+  const SurfacePeak near = findPeakInWindow(surface_,
+                                            cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
+                                                      static_cast<int>(std::lround(n / 2 + predicted.y))),
+                                            half, half, true, shape,
+                                            cv::Point2d(radius / 3.0, radius / 3.0), cv::Point(-10, -10),
+                                            noise_level);
   const double near_confidence = confidenceFrom(peakToSidelobeRatio(surface_, near, stats),
                                                 kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink);
+  if (prior->translation_ambiguous) {
+    // The prediction may follow an alias: the surface's highest peak is the better reading where
+    // no peak rivals it and the prediction's own peak reaches at most a competitor's share of it.
+    findRival(peak, floor(kTranslationPsrFloor), result);
+    const double near_ratio = overlapNormalisedHeight(near) / overlapNormalisedHeight(peak);
+    if (result.rival_ratio < 1.0 && near_ratio <= kCompetingTranslationPeak) {
+      result.translation_unrivalled = true;
+      return global;
+    }
+    result.rival_ratio = 0.0;  // the prediction decides, as usual
+  }
   result.followed_translation = cv::Point2d(near.sub_col - n / 2, near.sub_row - n / 2);
   result.followed_confidence = near_confidence;
   // Against the highest peak, a lower one counts as much less.
@@ -616,6 +648,62 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   if (plausible) return global;
   result.translation_implausible = true;
   return 0.0;
+}
+
+double Registrar::overlapShare(const cv::Point2d& shift) const {
+  const int n = static_cast<int>(overlap_share_.size());
+  const auto cell = [n](double v) { return std::min(static_cast<int>(std::lround(std::fabs(v))), n - 1); };
+  return std::max(overlap_share_[cell(shift.x)] * overlap_share_[cell(shift.y)], 1e-12);
+}
+
+double Registrar::overlapNormalisedHeight(const SurfacePeak& peak) const {
+  const int n = context_->size();
+  return peak.value / overlapShare(cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2));
+}
+
+void Registrar::findRival(const SurfacePeak& taken, float floor, PairRegistration& result) const {
+  result.rival_ratio = 0.0;
+  const int n = context_->size();
+  const auto cyclic = [n](int a, int b) { const int d = std::abs(a - b) % n; return std::min(d, n - d); };
+  const auto wrapped = [n](int i) { return ((i % n) + n) % n; };
+  if (!(taken.value > 0.0f)) return;
+  const cv::Point2d taken_shift(taken.sub_col - n / 2, taken.sub_row - n / 2);
+  const double taken_height = overlapNormalisedHeight(taken);
+  const double length = std::hypot(taken_shift.x, taken_shift.y);
+  const cv::Point2d along = length > 0.0 ? taken_shift * (1.0 / length) : cv::Point2d();
+  // A peak's own neighbourhood, as the peak-to-sidelobe ratio leaves it out [cells].
+  constexpr int kNeighbourhood = 5;
+  for (int r = 0; r < n; ++r) {
+    const float* row = surface_[r];
+    for (int c = 0; c < n; ++c) {
+      const float v = row[c];
+      if (!(v >= floor)) continue;
+      if (cyclic(r, taken.row) <= kNeighbourhood && cyclic(c, taken.col) <= kNeighbourhood) continue;
+      bool maximum = true;
+      for (int i = -1; i <= 1 && maximum; ++i) {
+        const float* neighbours = surface_[wrapped(r + i)];
+        for (int j = -1; j <= 1; ++j) maximum = maximum && !(neighbours[wrapped(c + j)] > v);
+      }
+      if (!maximum) continue;
+      const cv::Point2d shift(c - n / 2, r - n / 2);
+      // What does not move with the scene (vignetting, a sensor's fixed pattern) peaks at zero.
+      if (std::fabs(shift.x) <= kNeighbourhood && std::fabs(shift.y) <= kNeighbourhood) continue;
+      if (length > 0.0) {
+        const double projection = shift.x * along.x + shift.y * along.y;
+        const double across = std::fabs(shift.y * along.x - shift.x * along.y);
+        if (across <= kNeighbourhood && projection >= 0.5 * length && projection <= 2.0 * length) continue;
+      }
+      const double ratio = v / overlapShare(shift) / taken_height;
+      if (ratio > result.rival_ratio) {
+        result.rival_ratio = ratio;
+        result.rival_translation = shift;
+      }
+    }
+  }
+}
+
+double PairRegistration::uniqueness() const {
+  return std::clamp((1.0 - rival_ratio) / (1.0 - kCompetingTranslationPeak), 0.0, 1.0);
 }
 
 }  // namespace oefmt

@@ -51,6 +51,10 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        [](const Estimate& e) { return format("%.5f", pair12(e).shift); }},
       {"confidence", "", "pair 1-2's registration confidence, 0 (unusable) to 1",
        [](const Estimate& e) { return format("%.4f", pair12(e).confidence); }},
+      {"rival_ratio", "",
+       "height of the strongest rival of pair 1-2's translation peak relative to it, each divided by the "
+       "frames' overlap at its shift (0: none; near 1: an equally good reading, e.g. a periodic texture's alias)",
+       [](const Estimate& e) { return format("%.4f", pair12(e).rival_ratio); }},
       {"sigma_theta_rad", "rad", "sigma of theta_rad from the peak's width",
        [](const Estimate& e) { return format("%.8f", pair12(e).rotation_sigma); }},
       {"refined_theta_rad", "rad", "pair 1-2's rotation as the zoom refinement read it (0: not refined)",

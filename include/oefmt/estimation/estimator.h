@@ -57,6 +57,10 @@ struct Estimate {
   /// The measured step departed from the motion so far by more than the vehicle's acceleration
   /// allows: the predicted step was integrated instead (with a covariance covering both).
   bool step_implausible = false;
+  /// The motion so far rested on a reading a rival peak matched as well, and this pair's highest
+  /// translation peak, unrivalled, lay elsewhere: the window started over from it (the steps
+  /// before followed a periodic texture's alias).
+  bool alias_left = false;
   /// The measured turn deviated from the predicted one by several times what the last turns did
   /// (an outlier of the registration): the predicted turn was integrated instead.
   bool turn_predicted = false;

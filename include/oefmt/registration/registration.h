@@ -49,7 +49,13 @@ struct PairRegistration {
   std::vector<float> translation_energy;  ///< T: bin j <-> shift j * polarRadiusStep(); empty in classic
   double rotation_zoom_peak = 0.0;  ///< height of the rotation/zoom correlation peak (0..1)
   double translation_peak = 0.0;    ///< height of the translation correlation peak (0..1)
-  double confidence = 0.0;          ///< 0 (unusable) .. 1, from both peak-to-sidelobe ratios
+  /// 0 (unusable) .. 1, from both peak-to-sidelobe ratios: how clearly the peaks stand out of
+  /// their surfaces. The status is decided on it.
+  double peak_confidence = 0.0;
+  /// How far the reading can be trusted, 0 .. 1: peak_confidence times uniqueness(). A periodic
+  /// texture registered without a predicted translation stands out clearly at every period, and
+  /// which of those peaks is the motion is a guess: low.
+  double confidence = 0.0;
   /// Which rotation/zoom peak registered: 0 the first tried (the prior's window, if any, else the
   /// highest), 1.. the next highest; kPredicted: none, the prior's rotation and zoom were used.
   int rotation_zoom_candidate = 0;
@@ -67,6 +73,21 @@ struct PairRegistration {
   /// the highest.
   cv::Point2d followed_translation;
   double followed_confidence = 0.0;
+  /// Without a predicted translation (which otherwise decides between peaks), the strongest
+  /// rival of the translation peak taken: another peak in its own right, not a depth layer of
+  /// the same motion (the taken direction at half to twice its length), with both heights
+  /// divided by the share of the frames that overlaps at their shifts (a match's peak shrinks
+  /// with its overlap). Its height relative to the taken peak's (0: none), and its shift [px of
+  /// B]. Near 1, the two are equally good readings: a periodic texture's alias and the motion.
+  double rival_ratio = 0.0;
+  cv::Point2d rival_translation;
+  /// With a prior whose translation was ambiguous: the surface's highest peak was the better
+  /// reading (RegistrationPrior::translation_ambiguous) and was taken, wherever the prediction
+  /// pointed. rival_ratio is then its rival's.
+  bool translation_unrivalled = false;
+  /// How much the taken peak stands above its rival: 1 when the rival reaches at most
+  /// kCompetingTranslationPeak of its height, 0 when it is as high.
+  double uniqueness() const;
   /// The rotation or zoom lay outside the prior's window: not confident, whatever the peaks.
   bool rotation_zoom_implausible = false;
   /// The zoom was refined on the intensities (registration.refine_zoom), with the plane tilt
@@ -90,6 +111,9 @@ struct PairRegistration {
 
   bool usable() const { return status == RegistrationStatus::kOk; }
 };
+
+/// A translation peak's rival up to this share of its height leaves the reading unambiguous.
+constexpr double kCompetingTranslationPeak = 0.5;
 
 /// What the motion so far predicts for a pair's rotation and zoom. The rotation/zoom surface's
 /// highest values within the window are tried, and last the predicted rotation and zoom
@@ -125,6 +149,12 @@ struct RegistrationPrior {
   /// How far the last steps strayed from the prediction's constant motion [px]: its own
   /// uncertainty, without the vehicle's possible acceleration.
   double translation_sigma = 0.0;
+  /// The motion so far rests on readings that a rival peak matched as well (a periodic texture
+  /// since the last start): the prediction may follow an alias. The surface's highest peak is
+  /// then taken wherever it lies when no peak outdoes it as PairRegistration::rival_ratio
+  /// measures and the window's peak reaches at most kCompetingTranslationPeak of it
+  /// (PairRegistration::translation_unrivalled).
+  bool translation_ambiguous = false;
 };
 
 /// The shifts [px] of a registered pair's other depth layers, which the zoom refinement tests its
@@ -218,11 +248,21 @@ class Registrar {
   // window flags and returns the peak's confidence.
   double chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
                                PairRegistration& result);
+  // Sets the result's rival of the taken translation peak (PairRegistration::rival_ratio): the
+  // highest local maximum of surface_ that reaches `floor` and lies outside the taken peak's
+  // neighbourhood and depth layers.
+  void findRival(const SurfacePeak& taken, float floor, PairRegistration& result) const;
+  // The share of the windowed frames that overlaps at a shift [px], and a translation peak's
+  // height divided by it: a perfect match's height at any shift.
+  double overlapShare(const cv::Point2d& shift) const;
+  double overlapNormalisedHeight(const SurfacePeak& peak) const;
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
+  // The share of the windowed frames that overlaps at a shift of i cells along one axis.
+  std::vector<double> overlap_share_;
   cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)
   cv::Mat1f rotation_zoom_surface_;  // a view of rotation_zoom_power_
   SurfaceStats rotation_zoom_stats_;  // of the whole surface, for the peak-to-sidelobe ratios

@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A strictly periodic texture matches itself at every period of its lattice: registered without a
+// predicted translation, each of its correlation peaks is as good a reading of the motion as the
+// others, and the highest may be an alias. The registration names that rival and reports a low
+// confidence; a natural texture's peak has none. Where the motion so far rests on such a reading,
+// a clearly better peak elsewhere wins over the prediction.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include <opencv2/core.hpp>
+
+#include "estimation/estimator_measurements.h"
+#include "oefmt/registration/registration.h"
+#include "oefmt/sim/texture.h"
+#include "support/fixtures.h"
+
+namespace oefmt {
+namespace {
+
+constexpr int kN = 512;
+const cv::Point kShift(37, 9);  // the motion of the newer view's content [px]
+
+struct Views {
+  cv::Mat1f older;
+  cv::Mat1f newer;
+};
+
+// Two kN x kN views of `texture`, the newer one's content moved by `shift`.
+Views shiftedViews(const cv::Mat1f& texture, cv::Point shift) {
+  const cv::Point origin(texture.cols / 2 - kN / 2, texture.rows / 2 - kN / 2);
+  return {texture(cv::Rect(origin, cv::Size(kN, kN))).clone(),
+          texture(cv::Rect(origin - shift, cv::Size(kN, kN))).clone()};
+}
+
+// Within a quarter turn, as a vehicle's yaw rate bounds it: a brick wall also reads the same
+// turned by half a turn (test_periodic_heading.cpp).
+PairRegistration registerViews(const Views& views, const RegistrationPrior* prior = nullptr) {
+  Registrar registrar(test::sharedContext(kN));
+  const FrameSpectra older = registrar.analyse(views.older), newer = registrar.analyse(views.newer);
+  return registrar.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr, prior, CV_PI / 4.0);
+}
+
+TEST(TranslationRivals, APeriodicTexturesReadingWithoutAPredictionIsNotConfident) {
+  const double brick_px = 60.0;
+  const cv::Size brick = sim::brickSize(brick_px);
+  // Half a lattice period (half a brick along, a row across): the motion and its alias one period
+  // back lie as far from zero shift, and match equally well.
+  const cv::Point half_period(brick.width / 4, brick.height / 2);
+  const PairRegistration r = registerViews(shiftedViews(sim::brickTexture(1024, 5, brick_px), half_period));
+  std::printf("[ rivals ] brick: taken (%.1f, %.1f), rival (%.1f, %.1f) at %.3f, confidence %.3f of %.3f\n",
+              r.translation.x, r.translation.y, r.rival_translation.x, r.rival_translation.y, r.rival_ratio,
+              r.confidence, r.peak_confidence);
+  EXPECT_TRUE(r.usable()) << "the peaks stand out: the pair registers";
+  EXPECT_GT(r.rival_ratio, 0.9) << "another period matches as well";
+  EXPECT_LT(r.confidence, RegistrationConfig{}.min_confidence) << "which period is the motion is a guess";
+  // The rival lies a whole number of lattice periods from the taken peak: rows repeat every
+  // brick height, shifted by half a brick.
+  const cv::Point2d apart = r.rival_translation - r.translation;
+  const double rows = apart.y / brick.height;
+  const double bricks = (apart.x - std::round(rows) * brick.width / 2.0) / brick.width;
+  EXPECT_NEAR(rows, std::round(rows), 1.5 / brick.height);
+  EXPECT_NEAR(bricks, std::round(bricks), 1.5 / brick.width);
+}
+
+TEST(TranslationRivals, ANaturalTexturesPeakHasNoRival) {
+  const PairRegistration r = registerViews(shiftedViews(sim::naturalTexture(1024, 3, 48.0), kShift));
+  EXPECT_NEAR(r.translation.x, kShift.x, 0.5);
+  EXPECT_NEAR(r.translation.y, kShift.y, 0.5);
+  EXPECT_LT(r.rival_ratio, kCompetingTranslationPeak);
+  EXPECT_DOUBLE_EQ(r.uniqueness(), 1.0);
+  EXPECT_DOUBLE_EQ(r.confidence, r.peak_confidence);
+  EXPECT_GT(r.confidence, 0.9);
+}
+
+TEST(TranslationRivals, AnAmbiguousPredictionGivesWayToABetterPeak) {
+  const Views views = shiftedViews(sim::naturalTexture(1024, 3, 48.0), kShift);
+  // A prediction a brick period off (as a track that followed an alias would make), whose window
+  // leaves the motion out.
+  RegistrationPrior prior;
+  prior.rotation_sigma = 0.01;
+  prior.log_zoom_sigma = 0.005;
+  prior.rotation_window = 0.05;
+  prior.log_zoom_window = 0.03;
+  prior.translation = cv::Point2d(kShift.x + 60.0, kShift.y);
+  prior.translation_radius = 20.0;
+  prior.translation_sigma = 1.0;
+  const PairRegistration trusted = registerViews(views, &prior);
+  EXPECT_FALSE(trusted.translation_unrivalled);
+  EXPECT_TRUE(trusted.translation_implausible) << "a trusted prediction rules the motion out";
+  EXPECT_FALSE(trusted.usable());
+
+  prior.translation_ambiguous = true;
+  const PairRegistration doubted = registerViews(views, &prior);
+  EXPECT_TRUE(doubted.translation_unrivalled);
+  EXPECT_TRUE(doubted.usable());
+  EXPECT_NEAR(doubted.translation.x, kShift.x, 0.5);
+  EXPECT_NEAR(doubted.translation.y, kShift.y, 0.5);
+}
+
+TEST(TranslationRivals, ARivalAsHighMakesTheStepCovarianceCoverBothReadings) {
+  PairRegistration r;
+  r.translation = cv::Point2d(15.0, 10.0);
+  r.shift = cv::norm(r.translation);
+  r.direction = std::atan2(r.translation.y, r.translation.x);
+  r.shift_sigma = 0.5;
+  r.direction_sigma = 0.01;
+  r.rival_translation = cv::Point2d(-15.0, -10.0);
+  const UncertaintyConfig uncertainty;
+  const PairMotion alone = detail::calibrated(r, uncertainty);
+  r.rival_ratio = 1.0;  // as high: either reading, half and half
+  const PairMotion rivalled = detail::calibrated(r, uncertainty);
+  const cv::Vec2d apart(-30.0, -20.0);
+  const double along_rival = (apart.t() * rivalled.translation_covariance * apart)(0) / apart.dot(apart);
+  const double along_alone = (apart.t() * alone.translation_covariance * apart)(0) / apart.dot(apart);
+  EXPECT_NEAR(along_rival - along_alone, 0.25 * apart.dot(apart), 1e-6)
+      << "two readings half and half: a variance of a quarter of their distance squared";
+  r.rival_ratio = kCompetingTranslationPeak;  // no more than a competitor: the reading stands
+  const PairMotion unrivalled = detail::calibrated(r, uncertainty);
+  EXPECT_LT(cv::norm(unrivalled.translation_covariance - alone.translation_covariance), 1e-12);
+}
+
+}  // namespace
+}  // namespace oefmt
