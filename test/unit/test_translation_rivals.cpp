@@ -12,9 +12,12 @@
 #include <opencv2/core.hpp>
 
 #include "estimation/estimator_measurements.h"
+#include "oefmt/estimation/estimator.h"
 #include "oefmt/registration/registration.h"
+#include "oefmt/sim/flight.h"
 #include "oefmt/sim/texture.h"
 #include "support/fixtures.h"
+#include "support/flight_fixtures.h"
 
 namespace oefmt {
 namespace {
@@ -119,6 +122,47 @@ TEST(TranslationRivals, ARivalAsHighMakesTheStepCovarianceCoverBothReadings) {
   r.rival_ratio = kCompetingTranslationPeak;  // no more than a competitor: the reading stands
   const PairMotion unrivalled = detail::calibrated(r, uncertainty);
   EXPECT_LT(cv::norm(unrivalled.translation_covariance - alone.translation_covariance), 1e-12);
+}
+
+TEST(TranslationRivals, AFlightThatStartsOnABrickAliasLeavesItWithinAFewFrames) {
+  // A circle over brick on every layer, walls rendered: its motion runs along the bricks' rows,
+  // and its first pair's highest peak is an alias one period back.
+  sim::FlightOptions options;
+  options.texture_styles = {sim::TextureStyle::kBrick};
+  options.walls = true;
+  options.seed = 42;
+  constexpr int kFrames = 10;
+  const sim::FlightPlan plan = test::plannedFlight(options, kFrames);
+  const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
+  Estimator estimator(test::simulatedFlightConfig(plan));
+  int left_at = -1;
+  std::vector<double> ratios;  // estimated step length / true step length, after the alias
+  Pose4 previous;
+  for (int k = 0; k < kFrames; ++k) {
+    const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
+    ASSERT_TRUE(e.has_value());
+    if (k == 1) {
+      std::printf("[ rivals ] first pair: rival %.3f, confidence %.3f of %.3f\n", e->registration12.rival_ratio,
+                  e->registration12.confidence, e->registration12.peak_confidence);
+      EXPECT_GT(e->registration12.rival_ratio, 0.9) << "the premise: another period matches as well";
+      EXPECT_LT(e->registration12.confidence, RegistrationConfig{}.min_confidence);
+    }
+    if (e->alias_left && left_at < 0) left_at = k;
+    if (left_at >= 0 && k > left_at && e->state == TrackingState::kTracking) {
+      const cv::Vec3d true_step = plan.poses[k].position - plan.poses[k - 1].position;
+      ratios.push_back(std::hypot(e->pose.x - previous.x, e->pose.y - previous.y) /
+                       std::hypot(true_step[0], true_step[1]));
+      std::printf("[ rivals ] frame %d: step %.3f of the true length\n", k, ratios.back());
+    }
+    previous = e->pose;
+  }
+  std::printf("[ rivals ] the alias was left at frame %d\n", left_at);
+  ASSERT_GE(left_at, 2);
+  EXPECT_LE(left_at, 6) << "within a few frames";
+  ASSERT_GE(ratios.size(), 2u);
+  // After it the steps are the motion's (the estimator knows the true altitude: metric), not the
+  // alias's, a fifth of it.
+  for (const double ratio : ratios) EXPECT_NEAR(ratio, 1.0, 0.1);
 }
 
 }  // namespace
