@@ -615,10 +615,13 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
                                                 kTranslationPsrFloor * shrink, kTranslationPsrGood * shrink);
   if (prior->translation_ambiguous) {
     // The prediction may follow an alias: the surface's highest peak is the better reading where
-    // no peak rivals it and the prediction's own peak reaches at most a competitor's share of it.
+    // no peak outdoes it and the prediction's own peak reaches at most a competitor's share of it;
+    // where it is the prediction's own peak and has no rival, it confirms the prediction.
     findRival(peak, floor(kTranslationPsrFloor), result);
     const double near_ratio = overlapNormalisedHeight(near) / overlapNormalisedHeight(peak);
-    if (result.rival_ratio < 1.0 && near_ratio <= kCompetingTranslationPeak) {
+    const bool same = std::abs(near.row - peak.row) <= 1 && std::abs(near.col - peak.col) <= 1;
+    if (result.rival_ratio < 1.0 &&
+        (near_ratio <= kCompetingTranslationPeak || (same && result.uniqueness() >= 1.0))) {
       result.translation_unrivalled = true;
       return global;
     }

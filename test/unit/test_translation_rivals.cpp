@@ -100,6 +100,21 @@ TEST(TranslationRivals, AnAmbiguousPredictionGivesWayToABetterPeak) {
   EXPECT_TRUE(doubted.usable());
   EXPECT_NEAR(doubted.translation.x, kShift.x, 0.5);
   EXPECT_NEAR(doubted.translation.y, kShift.y, 0.5);
+
+  // A doubted prediction that the highest peak, unrivalled, confirms.
+  prior.translation = cv::Point2d(kShift.x + 3.0, kShift.y);
+  const PairRegistration confirmed = registerViews(views, &prior);
+  EXPECT_TRUE(confirmed.translation_unrivalled);
+  EXPECT_NEAR(confirmed.translation.x, kShift.x, 0.5);
+  EXPECT_NEAR(confirmed.translation.y, kShift.y, 0.5);
+  // Where a rival as high stands in the image (a periodic texture), the doubt stays.
+  const cv::Point half_period(sim::brickSize(60.0).width / 4, sim::brickSize(60.0).height / 2);
+  const Views bricks = shiftedViews(sim::brickTexture(1024, 5, 60.0), half_period);
+  prior.translation = cv::Point2d(half_period.x + 3.0, half_period.y);
+  const PairRegistration still_doubted = registerViews(bricks, &prior);
+  EXPECT_FALSE(still_doubted.translation_unrivalled);
+  EXPECT_NEAR(still_doubted.translation.x, half_period.x, 0.5) << "the prediction decides";
+  EXPECT_NEAR(still_doubted.translation.y, half_period.y, 0.5);
 }
 
 TEST(TranslationRivals, ARivalAsHighMakesTheStepCovarianceCoverBothReadings) {

@@ -82,8 +82,8 @@ struct PairRegistration {
   double rival_ratio = 0.0;
   cv::Point2d rival_translation;
   /// With a prior whose translation was ambiguous: the surface's highest peak was the better
-  /// reading (RegistrationPrior::translation_ambiguous) and was taken, wherever the prediction
-  /// pointed. rival_ratio is then its rival's.
+  /// reading, or the prediction's and unrivalled (RegistrationPrior::translation_ambiguous), and
+  /// was taken. rival_ratio is then its rival's. The estimator's doubt about its start ends.
   bool translation_unrivalled = false;
   /// How much the taken peak stands above its rival: 1 when the rival reaches at most
   /// kCompetingTranslationPeak of its height, 0 when it is as high.
@@ -152,7 +152,8 @@ struct RegistrationPrior {
   /// The motion so far rests on readings that a rival peak matched as well (a periodic texture
   /// since the last start): the prediction may follow an alias. The surface's highest peak is
   /// then taken wherever it lies when no peak outdoes it as PairRegistration::rival_ratio
-  /// measures and the window's peak reaches at most kCompetingTranslationPeak of it
+  /// measures and the window's peak reaches at most kCompetingTranslationPeak of it, or when it
+  /// is the window's peak and nothing rivals it, which confirms the prediction
   /// (PairRegistration::translation_unrivalled).
   bool translation_ambiguous = false;
 };
