@@ -56,9 +56,14 @@ void checkRegistration(const oefmt::PairRegistration& r, double min_confidence) 
   checkFinite(r.rotation_zoom_peak, "rotation/zoom peak finite");
   checkFinite(r.translation_peak, "translation peak finite");
   checkFinite(r.confidence, "confidence finite");
-  check(r.confidence >= 0.0 && r.confidence <= 1.0, "confidence in [0, 1]", r.confidence);
-  check(!r.usable() || r.confidence >= min_confidence, "usable implies min confidence",
+  checkFinite(r.peak_confidence, "peak confidence finite");
+  checkFinite(r.rival_ratio, "rival ratio finite");
+  check(r.peak_confidence >= 0.0 && r.peak_confidence <= 1.0, "peak confidence in [0, 1]", r.peak_confidence);
+  check(r.confidence >= 0.0 && r.confidence <= r.peak_confidence, "confidence in [0, peak confidence]",
         r.confidence);
+  check(r.rival_ratio >= 0.0, "rival ratio not negative", r.rival_ratio);
+  check(!r.usable() || r.peak_confidence >= min_confidence, "usable implies min peak confidence",
+        r.peak_confidence);
   for (float v : r.zoom_energy) checkFinite(v, "zoom energy finite");
   for (float v : r.translation_energy) checkFinite(v, "translation energy finite");
 }

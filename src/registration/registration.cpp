@@ -584,10 +584,10 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   const double mean = stats.abs_sum / count;
   const double deviation = std::sqrt(std::max(stats.square_sum / count - mean * mean, 0.0));
   // A rival must be a peak that could register the pair by itself.
-  const auto floor = [&](double psr) { return static_cast<float>(mean + psr * deviation); };
+  const auto peak_floor = [&](double psr) { return static_cast<float>(mean + psr * deviation); };
   result.translation_unrivalled = false;
   if (prior == nullptr || !(prior->translation_radius > 0.0)) {
-    findRival(peak, floor(kTranslationPsrFloor), result);
+    findRival(peak, peak_floor(kTranslationPsrFloor), result);
     return global;
   }
 
@@ -604,7 +604,7 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   const double cells = (2.0 * half + 1.0) * (2.0 * half + 1.0);
   const double shrink = std::log(cells) / std::log(static_cast<double>(n) * n);
   // Values below half that floor could not make a peak of any confidence: not searched.
-  const float noise_level = floor(0.5 * kTranslationPsrFloor * shrink);
+  const float noise_level = peak_floor(0.5 * kTranslationPsrFloor * shrink);
   const SurfacePeak near = findPeakInWindow(surface_,
                                             cv::Point(static_cast<int>(std::lround(n / 2 + predicted.x)),
                                                       static_cast<int>(std::lround(n / 2 + predicted.y))),
@@ -617,7 +617,7 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
     // The prediction may follow an alias: the surface's highest peak is the better reading where
     // no peak outdoes it and the prediction's own peak reaches at most a competitor's share of it;
     // where it is the prediction's own peak and has no rival, it confirms the prediction.
-    findRival(peak, floor(kTranslationPsrFloor), result);
+    findRival(peak, peak_floor(kTranslationPsrFloor), result);
     const double near_ratio = overlapNormalisedHeight(near) / overlapNormalisedHeight(peak);
     const bool same = std::abs(near.row - peak.row) <= 1 && std::abs(near.col - peak.col) <= 1;
     if (result.rival_ratio < 1.0 &&
