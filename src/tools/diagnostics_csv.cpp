@@ -41,6 +41,10 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        "1 when the measured zoom was an outlier of the last zooms' deviations from their predictions "
        "and the predicted zoom was integrated",
        [](const Estimate& e) { return format("%d", e.zoom_predicted ? 1 : 0); }},
+      {"alias_left", "",
+       "1 when the track had started on a reading a rival matched as well and this pair's unrivalled "
+       "highest translation peak, outside the predicted window, restarted the window from it",
+       [](const Estimate& e) { return format("%d", e.alias_left ? 1 : 0); }},
       {"theta_rad", "rad", "pair 1-2's registered rotation (counter-clockwise on screen)",
        [](const Estimate& e) { return format("%.8f", pair12(e).rotation); }},
       {"zoom", "", "pair 1-2's registered zoom (the newer frame looks this much larger)",
