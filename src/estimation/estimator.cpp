@@ -156,6 +156,11 @@ struct Estimator::State {
   bool registerAfterFailedFrame(const WindowFrame& frame, RegistrationMethod method,
                                 const std::optional<std::pair<double, double>>& turn,
                                 RegistrationSurfaces* surfaces, Estimate& est, double& rates_rotation12);
+  // Keeps track of whether the motion since the last start rests on an ambiguous reading (a
+  // rival peak as high) and, where this usable pair took the surface's unrivalled peak outside
+  // the prediction's window, starts the window over from frame 1 with it: true (pair 0-2 is then
+  // dropped).
+  bool weighAmbiguity(Estimate& est);
   // Multi-zoom step of the efmt mode; its fused profile goes to next_translation01.
   PairMotion efmtStep(const WindowFrame& frame, Estimate& est,
                       std::vector<float>& next_translation01);
@@ -564,6 +569,27 @@ void Estimator::State::slideTo(WindowFrame&& frame, const PairMotion& predicted)
   gap01 = 1;
   f0 = std::move(f1);
   f1 = std::move(frame);
+}
+
+bool Estimator::State::weighAmbiguity(Estimate& est) {
+  const PairRegistration& r = est.registration12;
+  if (!r.translation_unrivalled) {
+    if (!(prior12 && prior12->translation_radius > 0.0)) ambiguous_motion = r.uniqueness() < 1.0;
+    return false;
+  }
+  ambiguous_motion = false;
+  if (!prior12 || !(cv::norm(r.translation - prior12->translation) > prior12->translation_radius)) return false;
+  // The motion so far followed a periodic texture's alias: the window starts over from frame 1
+  // with this pair, as after a restart (the poses before stay as integrated).
+  if (pending02.valid()) pending02.wait();
+  pending02 = {};
+  f0.reset();
+  forgetPair01();
+  recent_steps.clear();
+  implausible_steps = 0;
+  prior12.reset();
+  est.alias_left = true;
+  return true;
 }
 
 PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
@@ -1019,25 +1045,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
         s.registrationFailed(std::move(frame), textured, est);
       }
     } else {
-      if (est.registration12.translation_unrivalled) {
-        s.ambiguous_motion = false;
-        if (s.prior12 && cv::norm(est.registration12.translation - s.prior12->translation) >
-                             s.prior12->translation_radius) {
-          // The motion so far followed a periodic texture's alias: the window starts over from
-          // frame 1 with this pair, as after a restart (the poses before stay as integrated).
-          if (s.pending02.valid()) s.pending02.wait();
-          s.pending02 = {};
-          with02 = false;
-          s.f0.reset();
-          s.forgetPair01();
-          s.recent_steps.clear();
-          s.implausible_steps = 0;
-          s.prior12.reset();
-          est.alias_left = true;
-        }
-      } else if (!(est.prediction12 && est.prediction12->translation_radius > 0.0)) {
-        s.ambiguous_motion = est.registration12.uniqueness() < 1.0;
-      }
+      if (s.weighAmbiguity(est)) with02 = false;
       est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
       std::vector<float> next_translation01 = est.registration12.translation_energy;
       PairMotion step = est.measured12;
