@@ -93,26 +93,6 @@ double gaussianPeakOffset(float left, float centre, float right) {
   return std::clamp(offset, -0.5, 0.5);
 }
 
-// Whether surface(r, c) is at least each of its eight neighbours (rows wrap; columns wrap if
-// cyclic_cols, else a neighbour beyond the border does not count).
-bool isLocalMaximum(const cv::Mat1f& surface, int r, int c, bool cyclic_cols) {
-  const float v = surface(r, c);
-  for (int dr = -1; dr <= 1; ++dr) {
-    const float* row = surface[wrap(r + dr, surface.rows)];
-    for (int dc = -1; dc <= 1; ++dc) {
-      if (dr == 0 && dc == 0) continue;
-      int cc = c + dc;
-      if (cyclic_cols) {
-        cc = wrap(cc, surface.cols);
-      } else if (cc < 0 || cc >= surface.cols) {
-        continue;
-      }
-      if (row[cc] > v) return false;
-    }
-  }
-  return true;
-}
-
 // The peak at `at` (of -surface when `negative`) refined on each axis by `shape`.
 SurfacePeak refinedPeak(const cv::Mat1f& surface, cv::Point at, bool negative, bool cyclic_cols,
                         PeakShape shape) {
@@ -141,6 +121,24 @@ SurfacePeak refinedPeak(const cv::Mat1f& surface, cv::Point at, bool negative, b
 }
 
 }  // namespace
+
+bool isLocalMaximum(const cv::Mat1f& surface, int r, int c, bool cyclic_cols) {
+  const float v = surface(r, c);
+  for (int dr = -1; dr <= 1; ++dr) {
+    const float* row = surface[wrap(r + dr, surface.rows)];
+    for (int dc = -1; dc <= 1; ++dc) {
+      if (dr == 0 && dc == 0) continue;
+      int cc = c + dc;
+      if (cyclic_cols) {
+        cc = wrap(cc, surface.cols);
+      } else if (cc < 0 || cc >= surface.cols) {
+        continue;
+      }
+      if (row[cc] > v) return false;
+    }
+  }
+  return true;
+}
 
 void normalisedCrossPower(const cv::Mat2f& newer, const cv::Mat2f& older, cv::Mat2f& out,
                           bool half_turn, SimdKernel kernel) {

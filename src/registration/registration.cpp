@@ -214,17 +214,7 @@ Registrar::Registrar(const RegistrationConfig& config)
 Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
     : context_(std::move(context)),
       builder_(context_),
-      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {
-  // A match's correlation peak grows with the windowed energy the two frames share at its shift.
-  const std::vector<float>& taper = context_->window().taper();
-  const int n = static_cast<int>(taper.size());
-  overlap_share_.assign(static_cast<size_t>(n), 0.0);
-  for (int shift = 0; shift < n; ++shift) {
-    for (int i = 0; i + shift < n; ++i) overlap_share_[shift] += double(taper[i]) * taper[i + shift];
-  }
-  const double whole = overlap_share_.empty() ? 0.0 : overlap_share_[0];
-  for (double& share : overlap_share_) share = whole > 0.0 ? share / whole : 0.0;
-}
+      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {}
 
 FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {
   return builder_.build(image, order);
@@ -653,22 +643,15 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
   return 0.0;
 }
 
-double Registrar::overlapShare(const cv::Point2d& shift) const {
-  const int n = static_cast<int>(overlap_share_.size());
-  const auto cell = [n](double v) { return std::min(static_cast<int>(std::lround(std::fabs(v))), n - 1); };
-  return std::max(overlap_share_[cell(shift.x)] * overlap_share_[cell(shift.y)], 1e-12);
-}
-
 double Registrar::overlapNormalisedHeight(const SurfacePeak& peak) const {
   const int n = context_->size();
-  return peak.value / overlapShare(cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2));
+  return peak.value / context_->window().overlapShare(cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2));
 }
 
 void Registrar::findRival(const SurfacePeak& taken, float floor, PairRegistration& result) const {
   result.rival_ratio = 0.0;
   const int n = context_->size();
   const auto cyclic = [n](int a, int b) { const int d = std::abs(a - b) % n; return std::min(d, n - d); };
-  const auto wrapped = [n](int i) { return ((i % n) + n) % n; };
   if (!(taken.value > 0.0f)) return;
   const cv::Point2d taken_shift(taken.sub_col - n / 2, taken.sub_row - n / 2);
   const double taken_height = overlapNormalisedHeight(taken);
@@ -682,12 +665,7 @@ void Registrar::findRival(const SurfacePeak& taken, float floor, PairRegistratio
       const float v = row[c];
       if (!(v >= floor)) continue;
       if (cyclic(r, taken.row) <= kNeighbourhood && cyclic(c, taken.col) <= kNeighbourhood) continue;
-      bool maximum = true;
-      for (int i = -1; i <= 1 && maximum; ++i) {
-        const float* neighbours = surface_[wrapped(r + i)];
-        for (int j = -1; j <= 1; ++j) maximum = maximum && !(neighbours[wrapped(c + j)] > v);
-      }
-      if (!maximum) continue;
+      if (!isLocalMaximum(surface_, r, c, true)) continue;
       const cv::Point2d shift(c - n / 2, r - n / 2);
       // What does not move with the scene (vignetting, a sensor's fixed pattern) peaks at zero.
       if (std::fabs(shift.x) <= kNeighbourhood && std::fabs(shift.y) <= kNeighbourhood) continue;
@@ -696,7 +674,7 @@ void Registrar::findRival(const SurfacePeak& taken, float floor, PairRegistratio
         const double across = std::fabs(shift.y * along.x - shift.x * along.y);
         if (across <= kNeighbourhood && projection >= 0.5 * length && projection <= 2.0 * length) continue;
       }
-      const double ratio = v / overlapShare(shift) / taken_height;
+      const double ratio = v / context_->window().overlapShare(shift) / taken_height;
       if (ratio > result.rival_ratio) {
         result.rival_ratio = ratio;
         result.rival_translation = shift;

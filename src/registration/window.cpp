@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/registration/window.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "oefmt/error.h"
@@ -14,6 +15,19 @@ SeparableWindow::SeparableWindow(int n, double taper_fraction) : taper_(static_c
     taper_[i] = h;
     taper_[n - 1 - i] = h;
   }
+  overlap_share_.assign(static_cast<size_t>(n), 0.0);
+  for (int shift = 0; shift < n; ++shift) {
+    for (int i = 0; i + shift < n; ++i) overlap_share_[shift] += double(taper_[i]) * taper_[i + shift];
+  }
+  const double whole = n > 0 ? overlap_share_[0] : 0.0;
+  for (double& share : overlap_share_) share = whole > 0.0 ? share / whole : 0.0;
+}
+
+double SeparableWindow::overlapShare(const cv::Point2d& shift) const {
+  const int n = size();
+  if (n == 0) return 1e-12;
+  const auto cell = [n](double v) { return std::min(static_cast<int>(std::lround(std::fabs(v))), n - 1); };
+  return std::max(overlap_share_[cell(shift.x)] * overlap_share_[cell(shift.y)], 1e-12);
 }
 
 void SeparableWindow::apply(const cv::Mat1f& in, cv::Mat1f& out, float offset) const {

@@ -328,5 +328,22 @@ TEST(Spectra, ThePreparedImagesStatisticsAreTheImagesOwn) {
   EXPECT_NEAR(scaled.mean, computed.mean * 1024.0 / 1.5, 1e-4);
 }
 
+TEST(SeparableWindow, OverlapShareIsTheWindowedEnergyTwoShiftedFramesShare) {
+  const int n = 64;
+  const SeparableWindow window(n, 0.1);
+  EXPECT_DOUBLE_EQ(window.overlapShare({0.0, 0.0}), 1.0);
+  // Separable, symmetric and falling with the shift along either axis.
+  double brute = 0.0, whole = 0.0;
+  for (int i = 0; i < n; ++i) {
+    whole += double(window.taper()[i]) * window.taper()[i];
+    if (i + 10 < n) brute += double(window.taper()[i]) * window.taper()[i + 10];
+  }
+  EXPECT_NEAR(window.overlapShare({10.0, 0.0}), brute / whole, 1e-12);
+  EXPECT_DOUBLE_EQ(window.overlapShare({-10.0, 0.0}), window.overlapShare({10.0, 0.0}));
+  EXPECT_NEAR(window.overlapShare({10.0, 10.0}), (brute / whole) * (brute / whole), 1e-12);
+  EXPECT_LT(window.overlapShare({20.0, 0.0}), window.overlapShare({10.0, 0.0}));
+  EXPECT_GT(window.overlapShare({1000.0, 0.0}), 0.0) << "beyond the frame: bounded away from 0";
+}
+
 }  // namespace
 }  // namespace oefmt

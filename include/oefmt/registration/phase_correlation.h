@@ -84,6 +84,10 @@ SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int hal
                              cv::Point2d sigma = {0.0, 0.0}, cv::Point exclude = {-10, -10},
                              float min_value = -std::numeric_limits<float>::infinity());
 
+/// Whether surface(r, c) is at least each of its eight neighbours (rows wrap; columns wrap if
+/// cyclic_cols, else a neighbour beyond the border does not count).
+bool isLocalMaximum(const cv::Mat1f& surface, int r, int c, bool cyclic_cols);
+
 /// Peak-to-sidelobe ratio: (peak - mean) / std of |surface|, excluding an 11 x 11 window at the
 /// peak, from the surface's sums gathered by findPeak. About 15 for unrelated textures at
 /// N = 512, hundreds for a clean registration.

@@ -253,17 +253,14 @@ class Registrar {
   // highest local maximum of surface_ that reaches `floor` and lies outside the taken peak's
   // neighbourhood and depth layers.
   void findRival(const SurfacePeak& taken, float floor, PairRegistration& result) const;
-  // The share of the windowed frames that overlaps at a shift [px], and a translation peak's
-  // height divided by it: a perfect match's height at any shift.
-  double overlapShare(const cv::Point2d& shift) const;
+  // A translation peak's height divided by the window's overlap share at its shift: a perfect
+  // match's height at any shift.
   double overlapNormalisedHeight(const SurfacePeak& peak) const;
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
-  // The share of the windowed frames that overlaps at a shift of i cells along one axis.
-  std::vector<double> overlap_share_;
   cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)
   cv::Mat1f rotation_zoom_surface_;  // a view of rotation_zoom_power_
   SurfaceStats rotation_zoom_stats_;  // of the whole surface, for the peak-to-sidelobe ratios

@@ -24,9 +24,13 @@ class SeparableWindow {
   /// image mean first keeps the window's own shape out of the spectrum (it would correlate at
   /// zero shift between any two frames).
   void apply(const cv::Mat1f& in, cv::Mat1f& out, float offset = 0.0f) const;
+  /// The share of the windowed energy that two frames shifted by `shift` [px] have in common
+  /// (1 at zero shift): a perfect match's correlation peak grows with it.
+  double overlapShare(const cv::Point2d& shift) const;
 
  private:
   std::vector<float> taper_;
+  std::vector<double> overlap_share_;  // per shift of 0 .. n - 1 cells along one axis
 };
 
 }  // namespace oefmt
