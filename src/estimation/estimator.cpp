@@ -531,6 +531,7 @@ PairMotion Estimator::State::plausibleStep(const PairMotion& step, Estimate& est
   }
   est.degraded = true;
   est.step_implausible = true;
+  est.length_source = LengthSource::kImplausible;
   PairMotion predicted = step;
   predicted.translation = prior12->translation;
   const double spread = cv::norm(off);
@@ -604,6 +605,7 @@ PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
   // later lengths follow it by PMT (or fall back to the fused profile's peak).
   double length = have01 ? refinedArgmax(mz.profile) * shift_per_bin : step.shift();
   double length_sigma = alongTrackSigma(step);
+  if (have01) est.length_source = LengthSource::kEnergyPeak;
   if (have01 && !translation01.empty() &&
       motion01.shift() >= config.matching.min_peak_bins * shift_per_bin) {
     t = Clock::now();
@@ -613,6 +615,7 @@ PairMotion Estimator::State::efmtStep(const WindowFrame& frame, Estimate& est,
                                                     motion01.shift() / shift_per_bin));
     est.matching_ms = msSince(t);
     if (est.pmt12.valid) {
+      est.length_source = LengthSource::kStretch;
       length = est.pmt12.value * motion01.shift();
       length_sigma = std::hypot(length * est.pmt12.sigma, est.pmt12.value * alongTrackSigma(motion01));
     }
@@ -685,6 +688,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
       detail::observe(reg12, est.measured12, est.pmt12, est.pms12, ref, config, shift_per_bin,
                       log_zoom_per_bin, double(gap12) / gap01, prior12 ? &*prior12 : nullptr, initial12);
   est.translation_use12 = obs12.translation_use;
+  est.length_source = obs12.length_source;
   est.measured12 = initial12;
   // With a predicted translation the observations already follow the layer (observe()).
   const bool predicted_translation = prior12 && prior12->translation_radius > 0.0;
@@ -692,7 +696,8 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
     return predicted_translation ? candidate
                                  : detail::steadyLayerStep(candidate, reg12, translation01,
                                                            ref.shift * gap12 / gap01, config,
-                                                           shift_per_bin, double(gap12) / gap01);
+                                                           shift_per_bin, double(gap12) / gap01,
+                                                           &est.length_source);
   };
   if (!usable02) return followLayer(initial12);  // no loop: the gated measurement
 
@@ -715,6 +720,9 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
     return initial12;
   }
   if (ref.shift > 0.0) est.lambda_t02 = est.loop.pair02.shift() / ref.shift;
+  if (std::fabs(est.loop.pair12.shift() - initial12.shift()) > config.tracking.layer_gate * initial12.shift()) {
+    est.length_source = LengthSource::kLoop;
+  }
   return followLayer(est.loop.pair12);
 }
 
@@ -794,6 +802,7 @@ PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) 
   // jump.
   if (!(std::fabs(*vouched - steady) < std::fabs(length - steady))) return step;
   est.vouched_length = *vouched;
+  est.length_source = LengthSource::kVouched;
   return atVouchedLength(step, *vouched);
 }
 
@@ -826,6 +835,7 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
   if (!(cv::norm(step.translation - prior12->translation) <= prior12->translation_radius)) return std::nullopt;
   est.measured12 = measured;
   est.vouched_length = vouched_length;
+  est.length_source = LengthSource::kVouched;
   return step;
 }
 
@@ -1049,6 +1059,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       est.measured12 = detail::calibrated(est.registration12, config_.uncertainty);
       std::vector<float> next_translation01 = est.registration12.translation_energy;
       PairMotion step = est.measured12;
+      est.length_source = LengthSource::kPeak;
       if (config_.mode == EstimatorMode::kEfmt) {
         step = s.efmtStep(frame, est, next_translation01);
       } else if (config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01) {

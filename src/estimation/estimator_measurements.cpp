@@ -55,6 +55,7 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
     return alongMotion(d) && std::fabs(cv::norm(d) - length) <= gate &&
            (!pmt_reads_layer || std::fabs(cv::norm(d) - pmt_length) <= pmt_gate);
   };
+  obs.length_source = LengthSource::kPeak;
   if (followed(measured.translation)) return;  // the correlation peak is the layer's
   if (registration.followed_confidence >= config.registration.min_confidence &&
       followed(registration.followed_translation)) {
@@ -62,6 +63,7 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
     // A lower peak than the correlation's: twice its sigma.
     obs.translation = registration.followed_translation;
     obs.translation_covariance = measured.translation_covariance * 4.0;
+    obs.length_source = LengthSource::kWindowPeak;
     initial = measured;
     initial.translation = obs.translation;
     initial.translation_covariance = obs.translation_covariance;
@@ -71,9 +73,10 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   // it (its direction holds); off it, an alias (nothing of it holds).
   const bool on_direction = measured.shift() > 0.0 && alongMotion(measured.translation);
   const std::vector<float> none;
+  LengthSource layered_source = LengthSource::kPrediction;
   const PairMotion layered =
       steadyLayerStep(measured, registration, ref.translation_energy ? *ref.translation_energy : none,
-                      length, config, shift_per_bin, intervals);
+                      length, config, shift_per_bin, intervals, &layered_source);
   // The energy vectors' stretch, where it differs from the peak's: the peak is another layer.
   const bool pmt_says_other_layer =
       pmt.valid && std::fabs(measured.shift() - pmt_length) > gate &&
@@ -81,17 +84,23 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   if (layered.translation == measured.translation && !pmt_says_other_layer) {
     // No layer tells the followed one's length: a peak the vehicle can reach is the motion's
     // change (its layer is followed from here).
-    if (on_direction && cv::norm(measured.translation - predicted) <= prior.translation_radius) return;
+    if (on_direction && cv::norm(measured.translation - predicted) <= prior.translation_radius) {
+      obs.length_source = LengthSource::kMotionChange;
+      return;
+    }
   }
   obs.translation_use = on_direction ? PairObservations::TranslationUse::kDirection
                                      : PairObservations::TranslationUse::kNone;
   double along = length, along_sigma = prior.translation_radius / 3.0;
+  obs.length_source = LengthSource::kPrediction;
   if (layered.translation != measured.translation) {
     along = layered.shift();
     along_sigma = alongTrackSigma(layered);
+    obs.length_source = layered_source;
   } else if (pmt_says_other_layer || pmt_reads_layer) {
     along = pmt_length;
     along_sigma = pmt_sigma;
+    obs.length_source = LengthSource::kStretch;
   }
   along_sigma = std::max(along_sigma, kMinShiftSigma);
   obs.shift.push_back({along, along_sigma});
@@ -296,6 +305,7 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
   if (std::fabs(measured.shift() - predicted) <= config.tracking.layer_gate * predicted) return obs;
 
   obs.translation_use = PairObservations::TranslationUse::kDirection;
+  obs.length_source = LengthSource::kStretch;
   double length = predicted;
   double length_sigma = predicted_sigma;
   const std::optional<double> bin =
@@ -307,6 +317,7 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
     length = *bin * shift_per_bin;
     length_sigma = 2.0 * alongTrackSigma(measured);
     obs.shift.push_back({length, length_sigma});
+    obs.length_source = LengthSource::kEnergyPeak;
   }
   initial = withLength(measured, length, std::max(length_sigma, kMinShiftSigma),
                        std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0)));
@@ -315,7 +326,8 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
                            const std::vector<float>& translation01, double steady,
-                           const EstimatorConfig& config, double shift_per_bin, double intervals) {
+                           const EstimatorConfig& config, double shift_per_bin, double intervals,
+                           LengthSource* source) {
   const TrackingConfig& tracking = config.tracking;
   const double length = candidate.shift();
   if (!(shift_per_bin > 0.0) || !(steady > 4.0 * config.matching.skip_bins * shift_per_bin) ||
@@ -350,6 +362,7 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
     }
   }
   if (!ratio) return candidate;
+  if (source != nullptr) *source = own ? LengthSource::kEnergyPeak : LengthSource::kLayerRatio;
   const double steady_length = steady * *ratio;
   // As for a followed layer's peak in observe(): twice the correlation peak's sigma along.
   const double across = std::sqrt(std::max(cv::trace(candidate.translation_covariance), 0.0));

@@ -143,9 +143,11 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
 /// told from a hop). Slow motion (a steady length within 4 x matching.skip_bins, where a static
 /// pattern's no-motion peak lies) is left alone too.
 /// `steady` is the followed layer's expected length [px] (pair 0-1's continued).
+/// `source` (if given) is set to LengthSource::kEnergyPeak or kLayerRatio where the step moved.
 PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& registration12,
                            const std::vector<float>& translation01, double steady,
-                           const EstimatorConfig& config, double shift_per_bin, double intervals);
+                           const EstimatorConfig& config, double shift_per_bin, double intervals,
+                           LengthSource* source = nullptr);
 
 }  // namespace detail
 }  // namespace oefmt

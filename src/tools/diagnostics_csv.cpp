@@ -97,6 +97,17 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        "distance of the step's other length readings (PMT stretch, highest peak) from the integrated "
        "length, added to the pose's covariance along the step; 0 when they agree",
        [](const Estimate& e) { return format("%.4f", e.length_spread); }},
+      {"length_source", "",
+       "which reading gave the integrated step's length: peak (the pair's translation peak), "
+       "window_peak (the peak where the prediction pointed; another layer's was higher), energy_peak "
+       "(the followed layer's peak in the translation energy vector), layer_ratio (a layer seen in both "
+       "pairs, through its ratio), stretch (the energy vectors' pattern match), prediction (the motion "
+       "so far; nothing in view read the followed layer), motion_change (a peak on the motion within "
+       "the acceleration window: the speed changed), loop (the three-frame loop moved it by more than "
+       "tracking.layer_gate), vouched (the ratios the layers in view held over the last steps), "
+       "implausible (the reading lay beyond the acceleration window: the prediction stands); none when "
+       "no step was integrated",
+       [](const Estimate& e) { return std::string(toString(e.length_source)); }},
       {"vouched_length_px", "px",
        "oefmt: the step length the depth layers in view vouched for by the ratios they held over the last "
        "steps, where the step's own broke them and was replaced by it, or where the pair was too weak to "

@@ -65,9 +65,11 @@ TEST(Estimator, ConstantSpeedStraightLine) {
   ASSERT_EQ(estimates.size(), flight.frames.size());
   expectFinite(estimates);
   EXPECT_EQ(estimates[0].state, TrackingState::kStarted);
+  EXPECT_EQ(estimates[0].length_source, LengthSource::kNone);
   for (std::size_t k = 1; k < estimates.size(); ++k) {
     const Estimate& e = estimates[k];
     EXPECT_EQ(e.state, TrackingState::kTracking) << k;
+    EXPECT_EQ(e.length_source, LengthSource::kPeak) << k;  // one layer: its peak every time
     if (k < 2) continue;
     ASSERT_TRUE(e.pmt12.valid) << k;
     ASSERT_TRUE(e.pmt02.valid) << k;
@@ -225,6 +227,12 @@ TEST(Estimator, MultiDepthFlightKeepsTheScaleOfTheFirstLayer) {
   bool gated = false;
   for (const Estimate& e : oefmt) gated |= e.translation_use12 != PairObservations::TranslationUse::kVector;
   EXPECT_TRUE(gated);
+  // ... and the diagnostics say which reading then gave the ground's length.
+  bool from_other_reading = false;
+  for (const Estimate& e : oefmt) {
+    from_other_reading |= e.length_source != LengthSource::kPeak && e.length_source != LengthSource::kNone;
+  }
+  EXPECT_TRUE(from_other_reading);
 }
 
 TEST(Estimator, UnregistrableFramesArePredictedThenTrackingResumes) {
@@ -243,6 +251,7 @@ TEST(Estimator, UnregistrableFramesArePredictedThenTrackingResumes) {
   expectFinite(estimates);
   EXPECT_EQ(estimates[5].state, TrackingState::kPredicted);
   EXPECT_EQ(estimates[6].state, TrackingState::kPredicted);
+  EXPECT_EQ(estimates[5].length_source, LengthSource::kNone);
   EXPECT_TRUE(estimates[5].degraded);
   EXPECT_GT(estimates[6].pose.covariance(0, 0), 10.0 * estimates[4].pose.covariance(0, 0));
   EXPECT_EQ(estimates[7].state, TrackingState::kTracking);

@@ -50,9 +50,11 @@ const std::vector<float>& groundAndRoofs01() {
 TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
   PairMotion loop = motionAlongX(132.5);
   loop.translation = {132.5 * std::cos(0.3), 132.5 * std::sin(0.3)};
+  LengthSource source = LengthSource::kNone;
   const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{92.7, 0.08}, {132.5, 1.0}}), groundAndRoofs01(),
-                                                  (92.7) * 1.0, EstimatorConfig(), kShiftPerBin, 1.0);
+                                                  (92.7) * 1.0, EstimatorConfig(), kShiftPerBin, 1.0, &source);
   EXPECT_NEAR(step.shift(), 92.7, 0.1);
+  EXPECT_EQ(source, LengthSource::kEnergyPeak);
   EXPECT_NEAR(step.direction(), 0.3, 1e-9);
   EXPECT_TRUE(step.finite());
   EXPECT_GE(cv::determinant(step.translation_covariance), 0.0);
@@ -61,9 +63,11 @@ TEST(SteadyLayerStep, AHopToTheRoofsGoesBackToTheGround) {
 // A real speed change (x1.6, one layer) leaves no peak at the steady length: it stands.
 TEST(SteadyLayerStep, ASpeedChangeStands) {
   const PairMotion loop = motionAlongX(148.3);
+  LengthSource source = LengthSource::kPeak;
   const PairMotion step = detail::steadyLayerStep(loop, withPeaks({{148.3, 1.0}}), groundAndRoofs01(), (92.7) * 1.0,
-                                                  EstimatorConfig(), kShiftPerBin, 1.0);
+                                                  EstimatorConfig(), kShiftPerBin, 1.0, &source);
   EXPECT_DOUBLE_EQ(step.shift(), 148.3);
+  EXPECT_EQ(source, LengthSource::kPeak);  // untouched: the step stood
 }
 
 // Pair 0-2 spans two of pair 0-1's intervals: steady speed means twice its shift.
@@ -99,10 +103,12 @@ TEST(SteadyLayerStep, StepsAtSteadySpeedOrWithoutEvidenceStand) {
 // roofs' scale, and follows a small speed change of those layers.
 TEST(SteadyLayerStep, TheFollowedLayerLeavingKeepsItsScale) {
   const std::vector<float> three01 = energyWithPeaks({{92.7, 1.0}, {119.5, 0.6}, {132.5, 0.3}});
+  LengthSource source = LengthSource::kNone;
   const PairMotion steady = detail::steadyLayerStep(
       motionAlongX(119.5), withPeaks({{92.7, 1.0}, {119.5, 0.7}}), three01, (132.5) * 1.0,
-      EstimatorConfig(), kShiftPerBin, 1.0);
+      EstimatorConfig(), kShiftPerBin, 1.0, &source);
   EXPECT_NEAR(steady.shift(), 132.5, 0.2);
+  EXPECT_EQ(source, LengthSource::kLayerRatio);
   const PairMotion faster = detail::steadyLayerStep(
       motionAlongX(121.9), withPeaks({{94.55, 1.0}, {121.9, 0.7}}), three01, (132.5) * 1.0,
       EstimatorConfig(), kShiftPerBin, 1.0);
@@ -170,6 +176,7 @@ TEST(ObserveFollowedLayer, ThePatternMatchKeepsTheLayerInsideAWideGate) {
   const PairMotion initial = observedWithStretch(1.0, &obs);
   EXPECT_NEAR(initial.shift(), 132.0, 0.5);
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
+  EXPECT_EQ(obs.length_source, LengthSource::kEnergyPeak);  // the roofs' own, small peak
   EXPECT_NEAR(initial.direction(), 0.0, 1e-9);
 }
 
@@ -179,6 +186,7 @@ TEST(ObserveFollowedLayer, APeakThePatternMatchConfirmsStands) {
   PairObservations obs;
   EXPECT_NEAR(observedWithStretch(0.0, &obs).shift(), 108.9, 1e-9);
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kVector);
+  EXPECT_EQ(obs.length_source, LengthSource::kPeak);
   EXPECT_NEAR(observedWithStretch(108.9 / 132.0, &obs).shift(), 108.9, 1e-9);
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kVector);
 }
@@ -188,17 +196,34 @@ TEST(ObserveFollowedLayer, APeakThePatternMatchConfirmsStands) {
 // layer's length to under a per cent, that peak is many of its sigmas off: the step keeps the
 // followed layer's own peak. Where the PMT is as loose as the layers are close, it cannot tell
 // them apart and the window's peak stands.
-PairMotion observedWithNeighbour(double pmt_sigma) {
+PairMotion observedWithNeighbour(double pmt_sigma, PairObservations* out = nullptr) {
   PairRegistration registration = withPeaks({{108.9, 1.0}, {132.0, 0.3}});
   registration.translation = {108.9, 0.0};
   registration.followed_translation = {125.9, 0.0};
   registration.followed_confidence = 1.0;
-  return observedAfter132(predicted132(0.5, 40.0), 0.3, registration, 1.0, pmt_sigma);
+  return observedAfter132(predicted132(0.5, 40.0), 0.3, registration, 1.0, pmt_sigma, out);
 }
 
 TEST(ObserveFollowedLayer, ATightPatternMatchTellsANeighbouringLayer) {
-  EXPECT_NEAR(observedWithNeighbour(0.008).shift(), 132.0, 0.5);
-  EXPECT_NEAR(observedWithNeighbour(0.03).shift(), 125.9, 1e-9);
+  PairObservations obs;
+  EXPECT_NEAR(observedWithNeighbour(0.008, &obs).shift(), 132.0, 0.5);
+  EXPECT_EQ(obs.length_source, LengthSource::kEnergyPeak);
+  EXPECT_NEAR(observedWithNeighbour(0.03, &obs).shift(), 125.9, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kWindowPeak);
+}
+
+// The followed layer has left the view and no layer or stretch reads it: a peak on the motion
+// that the vehicle could reach is taken as its change of speed, one it could not is not taken
+// and the prediction's length stands. The diagnostics say which.
+TEST(ObserveFollowedLayer, SaysWhetherTheSpeedChangedOrThePredictionStands) {
+  PairRegistration registration = withPeaks({{150.0, 1.0}});
+  registration.translation = {150.0, 0.0};
+  PairObservations obs;
+  EXPECT_NEAR(observedAfter132(predicted132(0.5, 30.0), 0.3, registration, 0.0, 0.0, &obs).shift(), 150.0, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kMotionChange);
+  EXPECT_NEAR(observedAfter132(predicted132(0.5, 10.0), 0.3, registration, 0.0, 0.0, &obs).shift(), 132.0, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kPrediction);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
 }
 
 // A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose

@@ -19,6 +19,7 @@
 #include "oefmt/estimation/local_optimizer.h"
 #include "oefmt/registration/pattern_matching.h"
 #include "oefmt/registration/registration.h"
+#include "oefmt/estimation/length_source.h"
 #include "oefmt/estimation/pose.h"
 
 namespace oefmt {
@@ -66,6 +67,8 @@ struct Estimate {
   bool turn_predicted = false;
   /// The same for the zoom: the predicted zoom was integrated instead of an outlier.
   bool zoom_predicted = false;
+  /// Which reading gave the integrated step's length (kNone when no step was integrated).
+  LengthSource length_source = LengthSource::kNone;
 
   // Raw registrations (energy vectors included; empty vectors in fmt mode).
   PairRegistration registration12;

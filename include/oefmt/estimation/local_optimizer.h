@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "oefmt/enum_names.h"
+#include "oefmt/estimation/length_source.h"
 #include "oefmt/estimation/pair_motion.h"
 
 namespace oefmt {
@@ -39,6 +40,9 @@ struct PairObservations {
   std::vector<ScalarObservation> shift;         ///< |d| [px]: PMT prediction, followed layer, ...
   /// Further (weak) priors on d, e.g. the motion predicted from the previous pair.
   std::vector<VectorObservation> translation_priors;
+  /// Which reading gave the length these observations hold d to (diagnostics; the optimizer does
+  /// not read it).
+  LengthSource length_source = LengthSource::kPeak;
 
   /// The observations of a registration: rotation, registration zoom and d (as kVector).
   static PairObservations fromMotion(const PairMotion& motion);
