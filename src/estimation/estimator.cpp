@@ -139,6 +139,15 @@ struct Estimator::State {
     turn_deviations.clear();
     zoom_deviations.clear();
   }
+  // The window starts over from frame 1 (a restart, or an alias left): nothing of pair 0-1 or of
+  // the steps before carries over, so the next registrations search everywhere (the rates, which
+  // the vehicle keeps, stay).
+  void startWindowOver() {
+    f0.reset();
+    forgetPair01();
+    recent_steps.clear();
+    implausible_steps = 0;
+  }
   void forgetPair01() {
     have01 = false;
     layer_ratios.clear();
@@ -465,13 +474,9 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   }
   if (failed <= config.tracking.max_failed_frames) return;
   // Too long without a registration: restart from this frame, continuing from this pose.
-  f0.reset();
-  forgetPair01();
+  startWindowOver();
   anchor.reset();
   last_step.reset();
-  // Nothing of the motion before carries over: the next registrations search everywhere.
-  recent_steps.clear();
-  implausible_steps = 0;
   failed = 0;
   if (textured) {
     f1 = std::move(frame);
@@ -584,10 +589,7 @@ bool Estimator::State::weighAmbiguity(Estimate& est) {
   // with this pair, as after a restart (the poses before stay as integrated).
   if (pending02.valid()) pending02.wait();
   pending02 = {};
-  f0.reset();
-  forgetPair01();
-  recent_steps.clear();
-  implausible_steps = 0;
+  startWindowOver();
   prior12.reset();
   est.alias_left = true;
   return true;
