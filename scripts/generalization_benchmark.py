@@ -184,6 +184,9 @@ PERIODIC = [
     )
 ]
 
+# The flight column's width in the printed lines: the longest name of any set.
+NAME_WIDTH = max(len(entry["name"]) for entry in CORPUS + HOLDOUT + PERIODIC)
+
 # A few minutes: what the test command runs and asserts on.
 CI_SUBSET = ["circle-parallax", "line-hill", "spin", "eight-natural-yaw", "circle-natural", "line-brick-flat"]
 
@@ -323,7 +326,7 @@ def main():
     pool = CORPUS + HOLDOUT + PERIODIC if args.flights else subsets.get(args.subset, CORPUS)
     if args.list:
         for entry in pool:
-            print(f"{entry['name']:18s} {entry['what']:55s} {' '.join(entry['options'])}")
+            print(f"{entry['name']:{NAME_WIDTH}s} {entry['what']:55s} {' '.join(entry['options'])}")
         return 0
     names = args.flights.split(",") if args.flights else (CI_SUBSET if args.subset == "ci" else None)
     flights = [f for f in pool if names is None or f["name"] in names]
@@ -420,7 +423,7 @@ def cell(value, digits=2):
 def print_row(row, modes):
     o = row["oefmt"] if "oefmt" in row else row[modes[0]]
     others = "  ".join(f"{m} {cell(row[m]['ate_mean'])}" for m in modes if m != "oefmt")
-    print(f"{row['name']:18s} oefmt ATE {cell(o['ate_mean'])} m, drift {cell(o['drift'])} %, "
+    print(f"{row['name']:{NAME_WIDTH}s} oefmt ATE {cell(o['ate_mean'])} m, drift {cell(o['drift'])} %, "
           f"heading>2deg {o['heading_over']}, lost {o['lost']}, time x{cell(o.get('time_ratio'))}  | {others}")
 
 
