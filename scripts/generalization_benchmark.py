@@ -185,7 +185,7 @@ PERIODIC = [
 ]
 
 # The flight column's width in the printed lines: the longest name of any set.
-NAME_WIDTH = max(len(entry["name"]) for entry in CORPUS + HOLDOUT + PERIODIC)
+NAME_WIDTH = max(len(entry["name"]) for entry in CORPUS + HOLDOUT + PERIODIC) + len("+range")
 
 # A few minutes: what the test command runs and asserts on.
 CI_SUBSET = ["circle-parallax", "line-hill", "spin", "eight-natural-yaw", "circle-natural", "line-brick-flat"]
@@ -306,6 +306,9 @@ def main():
                         help="the corpus, the test command's part of it, the flights outside it, or "
                         "periodic textures on every layer on further seeds")
     parser.add_argument("--flights", help="comma-separated flight names (instead of --subset)")
+    parser.add_argument("--rangefinder", action="store_true",
+                        help="the same flights with a downward rangefinder (range.txt, read by "
+                        "oefmt_offline for the altitude), rendered beside the others")
     parser.add_argument("--tools", default=None, help="folder of the oefmt programs "
                         "(default: build/devel/lib/oefmt of this source tree)")
     parser.add_argument("--work", default=None, help="renders and results (default build/generalization)")
@@ -337,6 +340,8 @@ def main():
     coverage = []
     warmed = False
     for entry in flights:
+        if args.rangefinder:
+            entry = dict(entry, name=entry["name"] + "+range", options=entry["options"] + ["--range"])
         folder = render(tools, work, entry)
         truth = os.path.join(folder, "groundtruth.tum")
         altitude = read_tum(truth)[0][3]
