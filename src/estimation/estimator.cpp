@@ -1023,6 +1023,16 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     est.registration12 = s.registrar.registerPair(s.f1->spectra, frame.spectra, method, surfaces,
                                                   s.prior12 ? &*s.prior12 : nullptr,
                                                   s.maxRotation(seconds12));
+    // A pair that found no rotation of its own takes the predicted one. The window is centred on
+    // the median of the last turns, robust to one wrong turn, but a turn that grows or shrinks
+    // steadily (a figure-8 flown with the heading on the track) has moved on by one and a half
+    // steps' change since that median: the turn continued at its steady change is the better
+    // guess. A gyro's turn, where one was given, stands.
+    if (!gyro_turn12 && s.prior12 && est.registration12.rotation_zoom_candidate == PairRegistration::kPredicted) {
+      if (const std::optional<double> turn = detail::steadilyChangingTurn(s.recent_rates)) {
+        est.registration12.rotation = wrapToPi(*turn * est.frame_gap);
+      }
+    }
     if (!est.registration12.usable() && !s.prior12 && config_.mode == EstimatorMode::kOefmt) {
       // Nothing predicted this pair and the rotation/zoom surface's highest peaks did not
       // register (at low overlap the shared part of two frames is small, and a wrong peak can be

@@ -222,6 +222,15 @@ PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>
   return step;
 }
 
+std::optional<double> steadilyChangingTurn(const std::deque<PairMotion>& rates) {
+  if (rates.size() < 3) return std::nullopt;
+  const double a = rates[rates.size() - 3].rotation, b = rates[rates.size() - 2].rotation, c = rates.back().rotation;
+  const double first = wrapToPi(b - a), second = wrapToPi(c - b);
+  if (!(first * second > 0.0)) return std::nullopt;
+  const double change = first > 0.0 ? std::min(first, second) : std::max(first, second);
+  return wrapToPi(b + 2.0 * change);
+}
+
 RateDeviations::RateDeviations(std::size_t frames, std::size_t support, double gate, double floor)
     : frames_(frames), support_(std::min(support, frames)), gate_(gate), floor_(floor) {}
 

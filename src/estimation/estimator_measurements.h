@@ -4,6 +4,7 @@
 #pragma once
 
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include "oefmt/estimation/estimator_config.h"
@@ -40,6 +41,14 @@ double medianOf(std::vector<double> values);
 /// the registration weakens, and the last step before them is often the one whose turn went
 /// wrong: repeated on every predicted frame it bent the trajectory by as much each time.
 PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>& rates);
+
+/// The turn per frame interval that the last three steps of `rates` (those that measured their
+/// rotation) give the next one where their turn changed steadily, growing or shrinking at each
+/// step: the middle one continued by twice the smaller of the two changes (a vehicle that eases
+/// into or out of a turn goes on doing so; a single wrong step makes the sequence either not
+/// steady or its change the larger one). Nothing with fewer than three such steps or an
+/// unsteady sequence (then their median is the prediction). [rad]
+std::optional<double> steadilyChangingTurn(const std::deque<PairMotion>& rates);
 
 /// The deviations of the last measured rates (a pair's turn, or its log-zoom) from what the
 /// rates before them predicted, which tell a reading that is an outlier of the measurement from a

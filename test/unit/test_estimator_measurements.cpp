@@ -280,6 +280,36 @@ TEST(ExtrapolatedStep, TurnsAndZoomsAtTheLastStepsMedianRates) {
   EXPECT_DOUBLE_EQ(alone.log_zoom, last.log_zoom);
 }
 
+// A figure-8 flown with the heading on the track eases into its turn: 2.31, 2.53, 2.77 degrees
+// per frame. The next frame turns about 3.0; the median of the three (2.53) lags a step and a
+// half behind. A single wrong turn does not make a trend, and one that looks like one is bounded
+// by the smaller change.
+TEST(SteadilyChangingTurn, ContinuesATurnThatGrowsOrShrinksSteadily) {
+  constexpr double kDeg = CV_PI / 180.0;
+  std::deque<PairMotion> rates(3, motionAlongX(40.0));
+  const auto turns = [&](double a, double b, double c) {
+    rates[0].rotation = a * kDeg;
+    rates[1].rotation = b * kDeg;
+    rates[2].rotation = c * kDeg;
+    return detail::steadilyChangingTurn(rates);
+  };
+  const std::optional<double> growing = turns(2.31, 2.53, 2.77);
+  ASSERT_TRUE(growing.has_value());
+  EXPECT_NEAR(*growing / kDeg, 2.97, 1e-9);  // 2.53 + 2 * 0.22
+  const std::optional<double> easing = turns(-1.89, -1.70, -1.53);
+  ASSERT_TRUE(easing.has_value());
+  EXPECT_NEAR(*easing / kDeg, -1.36, 1e-9);  // -1.70 + 2 * 0.17
+  // An outlier in the middle or first: not steady.
+  EXPECT_FALSE(turns(2.3, 3.5, 2.4).has_value());
+  EXPECT_FALSE(turns(3.5, 2.3, 2.4).has_value());
+  // An outlier last: the smaller change continues, not the outlier's.
+  EXPECT_NEAR(*turns(2.3, 2.4, 5.0) / kDeg, 2.6, 1e-9);
+  // A constant turn, and fewer than three steps: the median predicts.
+  EXPECT_FALSE(turns(1.0, 1.0, 1.0).has_value());
+  rates.pop_front();
+  EXPECT_FALSE(detail::steadilyChangingTurn(rates).has_value());
+}
+
 // A steady turn read to about 0.01 degrees, then one pair pulled 0.5 degrees off it: the outlier
 // is told, and not remembered. Two in a row are a change of the yaw rate: the second stands.
 TEST(RateDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
