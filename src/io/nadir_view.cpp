@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
 
 #include <opencv2/calib3d.hpp>
@@ -62,18 +61,15 @@ cv::Mat1f NadirView::apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_fr
                               rotation, virtual_camera_, cv::Size(working_size_, working_size_), CV_32FC1, map_x,
                               map_y);
   // Seen is where a virtual pixel's ray lands on the frame (pixel centres at integer
-  // coordinates, the frame's edge half a pixel beyond them) and the frame had a value there (a
-  // float frame's NaN or inf is no sight either). Sampling replicates the border, so the bicubic
-  // kernel's reach beyond the last pixel leaves the frame's edge rows seen: marking them unseen
-  // would fade a band of fade_px_ along every edge even of a level frame.
+  // coordinates, the frame's edge half a pixel beyond them). Sampling replicates the border, so
+  // the bicubic kernel's reach beyond the last pixel leaves the frame's edge rows seen: marking
+  // them unseen would fade a band of fade_px_ along every edge even of a level frame.
   cv::Mat1f view;
   cv::remap(grey, view, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-  cv::Mat1b seen_x, seen_y, seen, finite;
+  cv::Mat1b seen_x, seen_y, seen;
   cv::inRange(map_x, -0.5, grey.cols - 0.5, seen_x);
   cv::inRange(map_y, -0.5, grey.rows - 0.5, seen_y);
-  cv::inRange(view, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), finite);
   cv::bitwise_and(seen_x, seen_y, seen);
-  cv::bitwise_and(seen, finite, seen);
   // What the camera did not see fades out: within a ramp of the unseen part the texture blends
   // into the seen part's mean, which fills the rest. A hard edge there would move with the tilt
   // from frame to frame and pull the correlation as a texture of its own would.
