@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <opencv2/calib3d.hpp>
@@ -60,19 +61,13 @@ cv::Mat1f NadirView::apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_fr
   cv::initUndistortRectifyMap(cameraMatrix(source_camera_.intrinsics), source_camera_.distortion.coefficients(),
                               rotation, virtual_camera_, cv::Size(working_size_, working_size_), CV_32FC1, map_x,
                               map_y);
-  // Seen is where a virtual pixel's ray lands on the frame (pixel centres at integer
-  // coordinates, the frame's edge half a pixel beyond them). Sampling replicates the border, so
-  // the bicubic kernel's reach beyond the last pixel leaves the frame's edge rows seen: marking
-  // them unseen would fade a band of fade_px_ along every edge even of a level frame.
   cv::Mat1f view;
-  cv::remap(grey, view, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-  cv::Mat1b seen_x, seen_y, seen;
-  cv::inRange(map_x, -0.5, grey.cols - 0.5, seen_x);
-  cv::inRange(map_y, -0.5, grey.rows - 0.5, seen_y);
-  cv::bitwise_and(seen_x, seen_y, seen);
+  cv::remap(grey, view, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_CONSTANT,
+            cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()));
   // What the camera did not see fades out: within a ramp of the unseen part the texture blends
   // into the seen part's mean, which fills the rest. A hard edge there would move with the tilt
   // from frame to frame and pull the correlation as a texture of its own would.
+  cv::Mat1b seen = (view == view);  // false where NaN
   const int seen_pixels = cv::countNonZero(seen);
   if (seen_pixels == 0) throw InputError("the camera saw none of the level view (tilted too far)");
   if (seen_pixels == static_cast<int>(view.total())) return view;

@@ -86,34 +86,6 @@ TEST(Attitude, HistoryInterpolatesBetweenSamplesAndNotAcrossGaps) {
   EXPECT_FALSE(cameraTiltAt(level, 0.2).has_value());
 }
 
-TEST(NadirView, ALevelFrameComesOutAsItIsAndOnlyWhatWasNotSeenFades) {
-  constexpr int kN = 128;
-  cv::Mat1f frame(kN, kN);
-  cv::randu(frame, 0.0f, 255.0f);
-  CameraParameters camera;
-  camera.intrinsics = Intrinsics{100.0, 100.0, (kN - 1) / 2.0, (kN - 1) / 2.0, kN, kN};
-  const NadirView nadir(camera, cv::Size(kN, kN), camera.intrinsics.fx, kN);
-  // Level: every pixel, the edges' too, is the frame's own (the bicubic kernel's reach beyond
-  // the last row is no reason to fade it).
-  const cv::Mat1f level = nadir.apply(frame, nadirFromOptical(CameraTilt{}));
-  EXPECT_LT(cv::norm(level, frame, cv::NORM_INF), 1e-3);
-  // Rolled: the view's far side was not seen and holds the seen part's mean; the side the
-  // camera leans toward keeps the texture as seen from there, unfaded beyond the ramp.
-  const cv::Mat1f rolled = nadir.apply(frame, nadirFromOptical(CameraTilt{10.0 * kDeg, 0.0}));
-  int unseen_rows = 0, textured_rows = 0;
-  for (int y = 0; y < kN; ++y) {
-    double low = 0.0, high = 0.0;
-    cv::minMaxLoc(rolled.row(y), &low, &high);
-    if (high - low < 1e-3) {
-      ++unseen_rows;
-      EXPECT_NEAR(low, 127.5, 5.0) << "row " << y;
-    }
-    if (high - low > 100.0) ++textured_rows;
-  }
-  EXPECT_GT(unseen_rows, 5);
-  EXPECT_GT(textured_rows, kN / 2);
-}
-
 TEST(AttitudeAidedRegistration, PureRollOrPitchRegistersAsNoTranslation) {
   constexpr int kN = 256;
   sim::FlightOptions options;
