@@ -184,8 +184,12 @@ PERIODIC = [
     )
 ]
 
-# The flight column's width in the printed lines: the longest name of any set.
-NAME_WIDTH = max(len(entry["name"]) for entry in CORPUS + HOLDOUT + PERIODIC) + len("+range")
+# A flight flown again with a downward rangefinder (--rangefinder) is rendered under its name with
+# this suffix, beside the plain render.
+RANGEFINDER_SUFFIX = "+range"
+
+# The flight column's width in the printed lines: the longest name of any set, with the suffix.
+NAME_WIDTH = max(len(entry["name"]) for entry in CORPUS + HOLDOUT + PERIODIC) + len(RANGEFINDER_SUFFIX)
 
 # A few minutes: what the test command runs and asserts on.
 CI_SUBSET = ["circle-parallax", "line-hill", "spin", "eight-natural-yaw", "circle-natural", "line-brick-flat"]
@@ -341,7 +345,7 @@ def main():
     warmed = False
     for entry in flights:
         if args.rangefinder:
-            entry = dict(entry, name=entry["name"] + "+range", options=entry["options"] + ["--range"])
+            entry = dict(entry, name=entry["name"] + RANGEFINDER_SUFFIX, options=entry["options"] + ["--range"])
         folder = render(tools, work, entry)
         truth = os.path.join(folder, "groundtruth.tum")
         altitude = read_tum(truth)[0][3]
