@@ -61,20 +61,37 @@ cv::Mat1f NadirView::apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_fr
   cv::initUndistortRectifyMap(cameraMatrix(source_camera_.intrinsics), source_camera_.distortion.coefficients(),
                               rotation, virtual_camera_, cv::Size(working_size_, working_size_), CV_32FC1, map_x,
                               map_y);
+  // Seen is where a virtual pixel's ray lands on the frame (pixel centres at integer
+  // coordinates, the frame's edge half a pixel beyond them) and the frame had a value there (a
+  // float frame's NaN or inf is no sight either). Sampling replicates the border, so the bicubic
+  // kernel's reach beyond the last pixel leaves the frame's edge rows seen: a level frame comes
+  // out as it went in.
   cv::Mat1f view;
-  cv::remap(grey, view, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_CONSTANT,
-            cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+  cv::remap(grey, view, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  cv::Mat1b seen_x, seen_y, seen, finite;
+  cv::inRange(map_x, -0.5, grey.cols - 0.5, seen_x);
+  cv::inRange(map_y, -0.5, grey.rows - 0.5, seen_y);
+  cv::inRange(view, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), finite);
+  cv::bitwise_and(seen_x, seen_y, seen);
+  cv::bitwise_and(seen, finite, seen);
   // What the camera did not see fades out: within a ramp of the unseen part the texture blends
   // into the seen part's mean, which fills the rest. A hard edge there would move with the tilt
-  // from frame to frame and pull the correlation as a texture of its own would.
-  cv::Mat1b seen = (view == view);  // false where NaN
+  // from frame to frame and pull the correlation as a texture of its own would. The ramp is no
+  // wider than the unseen part is deep, so that it grows from nothing as the camera tilts away
+  // from level: a fixed ramp would fade a whole band the moment a single pixel goes unseen, and
+  // views of nearly the same attitude would differ by that band.
   const int seen_pixels = cv::countNonZero(seen);
   if (seen_pixels == 0) throw InputError("the camera saw none of the level view (tilted too far)");
   if (seen_pixels == static_cast<int>(view.total())) return view;
   const double mean = cv::mean(view, seen)[0];
-  cv::Mat1f distance;
+  cv::Mat1b unseen;
+  cv::bitwise_not(seen, unseen);
+  cv::Mat1f depth, distance;
+  cv::distanceTransform(unseen, depth, cv::DIST_L2, cv::DIST_MASK_3);
+  double deepest = 0.0;
+  cv::minMaxLoc(depth, nullptr, &deepest);
   cv::distanceTransform(seen, distance, cv::DIST_L2, cv::DIST_MASK_3);
-  const float ramp = static_cast<float>(fade_px_);
+  const float ramp = static_cast<float>(std::clamp(deepest, 1.0, fade_px_));
   for (int y = 0; y < view.rows; ++y) {
     float* v = view[y];
     const float* d = distance[y];

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -84,6 +85,87 @@ TEST(Attitude, HistoryInterpolatesBetweenSamplesAndNotAcrossGaps) {
   const Eigen::Matrix3d mount = Eigen::AngleAxisd(0.1745, Eigen::Vector3d::UnitY()).toRotationMatrix() * downLookingMount();
   EXPECT_NEAR(cameraTiltAt(level, 0.02, mount)->pitch, 0.1745, 1e-9);
   EXPECT_FALSE(cameraTiltAt(level, 0.2).has_value());
+}
+
+TEST(NadirView, ALevelFrameComesOutAsItIsAndOnlyWhatWasNotSeenFades) {
+  constexpr int kN = 128;
+  cv::Mat1f frame(kN, kN);
+  cv::randu(frame, 0.0f, 255.0f);
+  CameraParameters camera;
+  camera.intrinsics = Intrinsics{100.0, 100.0, (kN - 1) / 2.0, (kN - 1) / 2.0, kN, kN};
+  const NadirView nadir(camera, cv::Size(kN, kN), camera.intrinsics.fx, kN);
+  // Level: every pixel, the edges' too, is the frame's own (the bicubic kernel's reach beyond
+  // the last row is no reason to fade it).
+  const cv::Mat1f level = nadir.apply(frame, nadirFromOptical(CameraTilt{}));
+  EXPECT_LT(cv::norm(level, frame, cv::NORM_INF), 1e-3);
+  // Rolled: the view's far side was not seen and holds the seen part's mean; the side the
+  // camera leans toward keeps the texture as seen from there, unfaded beyond the ramp.
+  const cv::Mat1f rolled = nadir.apply(frame, nadirFromOptical(CameraTilt{10.0 * kDeg, 0.0}));
+  int unseen_rows = 0, textured_rows = 0;
+  for (int y = 0; y < kN; ++y) {
+    double low = 0.0, high = 0.0;
+    cv::minMaxLoc(rolled.row(y), &low, &high);
+    if (high - low < 1e-3) {
+      ++unseen_rows;
+      EXPECT_NEAR(low, 127.5, 5.0) << "row " << y;
+    }
+    if (high - low > 100.0) ++textured_rows;
+  }
+  EXPECT_GT(unseen_rows, 5);
+  EXPECT_GT(textured_rows, kN / 2);
+  // A float frame's missing pixels are not seen either: faded like the rest, never passed on.
+  cv::Mat1f holed = frame.clone();
+  holed(kN / 2, kN / 2) = std::numeric_limits<float>::quiet_NaN();
+  holed(3, 7) = std::numeric_limits<float>::infinity();
+  for (const CameraTilt tilt : {CameraTilt{}, CameraTilt{10.0 * kDeg, 0.0}}) {
+    EXPECT_TRUE(cv::checkRange(nadir.apply(holed, nadirFromOptical(tilt)))) << tilt.roll;
+  }
+  // Level, beyond the fade around the holes the frame is its own.
+  const cv::Rect far_from_holes(kN - 40, kN - 40, 40, 40);
+  EXPECT_LT(cv::norm(nadir.apply(holed, nadirFromOptical(CameraTilt{}))(far_from_holes), frame(far_from_holes),
+                     cv::NORM_INF),
+            1e-3);
+}
+
+TEST(NadirView, TheFadeGrowsFromNothingAsTheCameraTiltsAwayFromLevel) {
+  // Views of nearly the same attitude are nearly the same, also where the first row of the view
+  // goes unseen: that row takes the mean, and no band along the edge fades with it (a folder's
+  // attitudes, printed to nine digits, and a bag's doubles then give the same trajectory).
+  constexpr int kN = 128;
+  cv::Mat1f frame(kN, kN);
+  cv::randu(frame, 0.0f, 255.0f);
+  CameraParameters camera;
+  camera.intrinsics = Intrinsics{100.0, 100.0, (kN - 1) / 2.0, (kN - 1) / 2.0, kN, kN};
+  const NadirView nadir(camera, cv::Size(kN, kN), camera.intrinsics.fx, kN);
+  const auto view = [&](double roll) { return nadir.apply(frame, nadirFromOptical(CameraTilt{roll, 0.0})); };
+  const auto anyRowUnseen = [&](const cv::Mat1f& v) {
+    for (int y = 0; y < kN; ++y) {
+      double low = 0.0, high = 0.0;
+      cv::minMaxLoc(v.row(y), &low, &high);
+      if (high - low < 1e-3) return true;
+    }
+    return false;
+  };
+  // The roll at which a row of the view first goes unseen.
+  double seen = 0.0, unseen = 2.0 * kDeg;
+  ASSERT_FALSE(anyRowUnseen(view(seen)));
+  ASSERT_TRUE(anyRowUnseen(view(unseen)));
+  while (unseen - seen > 1e-10) {
+    const double middle = 0.5 * (seen + unseen);
+    (anyRowUnseen(view(middle)) ? unseen : seen) = middle;
+  }
+  cv::Mat1f difference;
+  cv::absdiff(view(seen), view(unseen), difference);
+  EXPECT_LE(cv::countNonZero(difference > 1.0f), 2 * kN) << "more than the row that went unseen changed";
+  // Further on, the ramp widens with what was not seen, up to its full width.
+  const cv::Mat1f tilted = view(6.0 * kDeg);
+  int faded_rows = 0;
+  for (int y = 0; y < kN; ++y) {
+    cv::Scalar mean, spread;
+    cv::meanStdDev(tilted.row(y), mean, spread);
+    if (spread[0] > 1e-3 && spread[0] < 0.8 * 255.0 / std::sqrt(12.0)) ++faded_rows;
+  }
+  EXPECT_GE(faded_rows, 3);
 }
 
 TEST(AttitudeAidedRegistration, PureRollOrPitchRegistersAsNoTranslation) {
