@@ -87,13 +87,24 @@ TEST(Attitude, HistoryInterpolatesBetweenSamplesAndNotAcrossGaps) {
   EXPECT_FALSE(cameraTiltAt(level, 0.2).has_value());
 }
 
-TEST(NadirView, ALevelFrameComesOutAsItIsAndOnlyWhatWasNotSeenFades) {
-  constexpr int kN = 128;
-  cv::Mat1f frame(kN, kN);
-  cv::randu(frame, 0.0f, 255.0f);
+// A kNadirN-pixel square camera of focal length 100 px and its level view at the same size.
+constexpr int kNadirN = 128;
+
+NadirView squareNadirView() {
   CameraParameters camera;
-  camera.intrinsics = Intrinsics{100.0, 100.0, (kN - 1) / 2.0, (kN - 1) / 2.0, kN, kN};
-  const NadirView nadir(camera, cv::Size(kN, kN), camera.intrinsics.fx, kN);
+  camera.intrinsics = Intrinsics{100.0, 100.0, (kNadirN - 1) / 2.0, (kNadirN - 1) / 2.0, kNadirN, kNadirN};
+  return NadirView(camera, cv::Size(kNadirN, kNadirN), camera.intrinsics.fx, kNadirN);
+}
+
+cv::Mat1f whiteNoiseFrame() {
+  cv::Mat1f frame(kNadirN, kNadirN);
+  cv::randu(frame, 0.0f, 255.0f);
+  return frame;
+}
+
+TEST(NadirView, ALevelFrameComesOutAsItIsAndOnlyWhatWasNotSeenFades) {
+  const cv::Mat1f frame = whiteNoiseFrame();
+  const NadirView nadir = squareNadirView();
   // Level: every pixel, the edges' too, is the frame's own (the bicubic kernel's reach beyond
   // the last row is no reason to fade it).
   const cv::Mat1f level = nadir.apply(frame, nadirFromOptical(CameraTilt{}));
@@ -102,7 +113,7 @@ TEST(NadirView, ALevelFrameComesOutAsItIsAndOnlyWhatWasNotSeenFades) {
   // camera leans toward keeps the texture as seen from there, unfaded beyond the ramp.
   const cv::Mat1f rolled = nadir.apply(frame, nadirFromOptical(CameraTilt{10.0 * kDeg, 0.0}));
   int unseen_rows = 0, textured_rows = 0;
-  for (int y = 0; y < kN; ++y) {
+  for (int y = 0; y < kNadirN; ++y) {
     double low = 0.0, high = 0.0;
     cv::minMaxLoc(rolled.row(y), &low, &high);
     if (high - low < 1e-3) {
@@ -112,16 +123,16 @@ TEST(NadirView, ALevelFrameComesOutAsItIsAndOnlyWhatWasNotSeenFades) {
     if (high - low > 100.0) ++textured_rows;
   }
   EXPECT_GT(unseen_rows, 5);
-  EXPECT_GT(textured_rows, kN / 2);
+  EXPECT_GT(textured_rows, kNadirN / 2);
   // A float frame's missing pixels are not seen either: faded like the rest, never passed on.
   cv::Mat1f holed = frame.clone();
-  holed(kN / 2, kN / 2) = std::numeric_limits<float>::quiet_NaN();
+  holed(kNadirN / 2, kNadirN / 2) = std::numeric_limits<float>::quiet_NaN();
   holed(3, 7) = std::numeric_limits<float>::infinity();
   for (const CameraTilt tilt : {CameraTilt{}, CameraTilt{10.0 * kDeg, 0.0}}) {
     EXPECT_TRUE(cv::checkRange(nadir.apply(holed, nadirFromOptical(tilt)))) << tilt.roll;
   }
   // Level, beyond the fade around the holes the frame is its own.
-  const cv::Rect far_from_holes(kN - 40, kN - 40, 40, 40);
+  const cv::Rect far_from_holes(kNadirN - 40, kNadirN - 40, 40, 40);
   EXPECT_LT(cv::norm(nadir.apply(holed, nadirFromOptical(CameraTilt{}))(far_from_holes), frame(far_from_holes),
                      cv::NORM_INF),
             1e-3);
@@ -131,15 +142,11 @@ TEST(NadirView, TheFadeGrowsFromNothingAsTheCameraTiltsAwayFromLevel) {
   // Views of nearly the same attitude are nearly the same, also where the first row of the view
   // goes unseen: that row takes the mean, and no band along the edge fades with it (a folder's
   // attitudes, printed to nine digits, and a bag's doubles then give the same trajectory).
-  constexpr int kN = 128;
-  cv::Mat1f frame(kN, kN);
-  cv::randu(frame, 0.0f, 255.0f);
-  CameraParameters camera;
-  camera.intrinsics = Intrinsics{100.0, 100.0, (kN - 1) / 2.0, (kN - 1) / 2.0, kN, kN};
-  const NadirView nadir(camera, cv::Size(kN, kN), camera.intrinsics.fx, kN);
+  const cv::Mat1f frame = whiteNoiseFrame();
+  const NadirView nadir = squareNadirView();
   const auto view = [&](double roll) { return nadir.apply(frame, nadirFromOptical(CameraTilt{roll, 0.0})); };
   const auto anyRowUnseen = [&](const cv::Mat1f& v) {
-    for (int y = 0; y < kN; ++y) {
+    for (int y = 0; y < kNadirN; ++y) {
       double low = 0.0, high = 0.0;
       cv::minMaxLoc(v.row(y), &low, &high);
       if (high - low < 1e-3) return true;
@@ -156,11 +163,11 @@ TEST(NadirView, TheFadeGrowsFromNothingAsTheCameraTiltsAwayFromLevel) {
   }
   cv::Mat1f difference;
   cv::absdiff(view(seen), view(unseen), difference);
-  EXPECT_LE(cv::countNonZero(difference > 1.0f), 2 * kN) << "more than the row that went unseen changed";
+  EXPECT_LE(cv::countNonZero(difference > 1.0f), 2 * kNadirN) << "more than the row that went unseen changed";
   // Further on, the ramp widens with what was not seen, up to its full width.
   const cv::Mat1f tilted = view(6.0 * kDeg);
   int faded_rows = 0;
-  for (int y = 0; y < kN; ++y) {
+  for (int y = 0; y < kNadirN; ++y) {
     cv::Scalar mean, spread;
     cv::meanStdDev(tilted.row(y), mean, spread);
     if (spread[0] > 1e-3 && spread[0] < 0.8 * 255.0 / std::sqrt(12.0)) ++faded_rows;
