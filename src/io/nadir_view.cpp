@@ -41,6 +41,19 @@ NadirView::NadirView(const CameraParameters& camera, cv::Size image_size, double
 }
 
 cv::Mat1f NadirView::apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_from_optical, ChannelOrder order) const {
+  return render(image, nadir_from_optical, order, nullptr);
+}
+
+PreparedImage NadirView::prepare(const cv::Mat& image, const Eigen::Matrix3d& nadir_from_optical,
+                                 ChannelOrder order) const {
+  cv::Mat1b seen;
+  PreparedImage prepared = prepareImage(render(image, nadir_from_optical, order, &seen), working_size_);
+  prepared.seen = seen;
+  return prepared;
+}
+
+cv::Mat1f NadirView::render(const cv::Mat& image, const Eigen::Matrix3d& nadir_from_optical, ChannelOrder order,
+                            cv::Mat1b* seen_out) const {
   if (image.size() != image_size_) {
     throw InputError("the frame is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                      " but the nadir view was set up for " + std::to_string(image_size_.width) + "x" +
@@ -82,6 +95,7 @@ cv::Mat1f NadirView::apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_fr
   // views of nearly the same attitude would differ by that band.
   const int seen_pixels = cv::countNonZero(seen);
   if (seen_pixels == 0) throw InputError("the camera saw none of the level view (tilted too far)");
+  if (seen_out != nullptr) seen_out->release();
   if (seen_pixels == static_cast<int>(view.total())) return view;
   const double mean = cv::mean(view, seen)[0];
   cv::Mat1b unseen;
@@ -92,6 +106,8 @@ cv::Mat1f NadirView::apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_fr
   cv::minMaxLoc(depth, nullptr, &deepest);
   cv::distanceTransform(seen, distance, cv::DIST_L2, cv::DIST_MASK_3);
   const float ramp = static_cast<float>(std::clamp(deepest, 1.0, fade_px_));
+  // The camera's own pixels are those the fade leaves as they are.
+  if (seen_out != nullptr) cv::compare(distance, ramp, *seen_out, cv::CMP_GE);
   for (int y = 0; y < view.rows; ++y) {
     float* v = view[y];
     const float* d = distance[y];

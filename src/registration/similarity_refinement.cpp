@@ -76,21 +76,32 @@ struct InverseMap {
 };
 
 // The older frame at the point the newer frame's pixel (x, y) maps to: its bilinear value and
-// derivatives; false outside it.
-bool olderAt(const cv::Mat1f& older, const InverseMap& map, int x, int y, double& a, double& ax, double& ay) {
+// derivatives; false outside it, and where either frame shows what its camera did not see
+// (RefinementImage::seen): a levelled view's fill is the same in both frames wherever the scene
+// moves, and read as texture it would pull the fit toward no motion.
+bool olderAt(const RefinementImage& older, const RefinementImage& newer, const InverseMap& map, int x, int y,
+             double& a, double& ax, double& ay) {
+  if (!newer.seen.empty() && newer.seen(y, x) == 0) return false;
   const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
-  return bilinear(older, map.c + map.i00 * qx + map.i01 * qy, map.c + map.i10 * qx + map.i11 * qy, a, ax, ay);
+  const double sx = map.c + map.i00 * qx + map.i01 * qy, sy = map.c + map.i10 * qx + map.i11 * qy;
+  if (!bilinear(older.smooth, sx, sy, a, ax, ay)) return false;
+  if (older.seen.empty()) return true;
+  // bilinear's four pixels (inside the frame, as it checked).
+  const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+  const unsigned char* r0 = older.seen[y0];
+  const unsigned char* r1 = older.seen[y0 + 1];
+  return r0[x0] != 0 && r0[x0 + 1] != 0 && r1[x0] != 0 && r1[x0 + 1] != 0;
 }
 
-PixelResidual residualAt(const cv::Mat1f& older, const cv::Mat1f& newer, const InverseMap& map,
+PixelResidual residualAt(const RefinementImage& older, const RefinementImage& newer, const InverseMap& map,
                          double gain, double bias, int x, int y) {
   PixelResidual p;
   double a = 0.0, ax = 0.0, ay = 0.0;
-  if (!olderAt(older, map, x, y, a, ax, ay)) return p;
-  const float* row = newer[y];
+  if (!olderAt(older, newer, map, x, y, a, ax, ay)) return p;
+  const float* row = newer.smooth[y];
   // The older frame's gradient at the source point maps to the newer's by M^-T = [i00 i10; i01 i11].
   p.gx = 0.5 * (gain * (map.i00 * ax + map.i10 * ay) + 0.5 * (row[x + 1] - row[x - 1]));
-  p.gy = 0.5 * (gain * (map.i01 * ax + map.i11 * ay) + 0.5 * (newer(y + 1, x) - newer(y - 1, x)));
+  p.gy = 0.5 * (gain * (map.i01 * ax + map.i11 * ay) + 0.5 * (newer.smooth(y + 1, x) - newer.smooth(y - 1, x)));
   p.r = row[x] - (gain * a + bias);
   p.a = a;
   p.inside = true;
@@ -170,10 +181,10 @@ class BlockMask {
 // refinement must measure the followed layer's motion, and where the texture is weak against the
 // noise, Tukey's biweight cannot tell a pixel of another layer from a noisy one, so those layers
 // pull the zoom towards their own.
-BlockMask followedLayerBlocks(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+BlockMask followedLayerBlocks(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
                               const ImageSimilarity& start, const std::vector<cv::Point2d>& other_layers,
                               double bias, int stride) {
-  const int n = newer.rows;
+  const int n = newer.smooth.rows;
   BlockMask blocks(n);
   if (other_layers.empty()) return blocks;
   const InverseMap followed(start, n);
@@ -195,12 +206,12 @@ BlockMask followedLayerBlocks(const cv::Mat1f& older, const cv::Mat1f& newer, co
       if (!(taper[x] > 0.0f)) continue;
       // residualAt's residual at gain 1, without its symmetric gradient.
       double a = 0.0, ax = 0.0, ay = 0.0;
-      if (!olderAt(older, followed, x, y, a, ax, ay)) continue;
-      const double own = newer(y, x) - (a + bias);
+      if (!olderAt(older, newer, followed, x, y, a, ax, ay)) continue;
+      const double own = newer.smooth(y, x) - (a + bias);
       const std::size_t block = static_cast<std::size_t>(blocks.index(x, y));
       for (std::size_t i = 0; i < others.size(); ++i) {
-        if (!olderAt(older, others[i], x, y, a, ax, ay)) continue;
-        const double other = newer(y, x) - (a + bias);
+        if (!olderAt(older, newer, others[i], x, y, a, ax, ay)) continue;
+        const double other = newer.smooth(y, x) - (a + bias);
         const double d = own * own - other * other;
         Sums& s = sums[block * others.size() + i];
         s.d += d;
@@ -226,10 +237,10 @@ BlockMask followedLayerBlocks(const cv::Mat1f& older, const cv::Mat1f& newer, co
 
 // Robust sigma (robustScale) over every `stride`-th pixel inside both frames and in a kept
 // block; negative when too few are.
-double robustSigma(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+double robustSigma(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
                    const BlockMask& blocks, const ImageSimilarity& motion, double gain, double bias,
                    int stride, std::vector<float>& scratch, int* count) {
-  const int n = newer.rows;
+  const int n = newer.smooth.rows;
   const InverseMap map(motion, n);
   scratch.clear();
   for (int y = stride / 2 + 1; y < n - 1; y += stride) {
@@ -253,10 +264,10 @@ struct LossChange {
 // The change of the biweight loss (at `sigma`) from motion `a` to motion `b` over the pixels of
 // the sparse grid inside both frames at both, and its standard error: the pixels are paired, so
 // the texture's own spread of the loss cancels and what is left is the change's noise.
-LossChange lossChange(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+LossChange lossChange(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
                       const BlockMask& blocks, const ImageSimilarity& a, double gain_a, double bias_a,
                       const ImageSimilarity& b, double gain_b, double bias_b, int stride, double sigma) {
-  const int n = newer.rows;
+  const int n = newer.smooth.rows;
   const InverseMap map_a(a, n), map_b(b, n);
   const double limit = kTukey * sigma;
   double sum = 0.0, sum2 = 0.0;
@@ -311,9 +322,9 @@ double gradientNoiseVariance(double older_variance, double newer_variance) {
 // contrast sets the first step's robust scale, under which the biweight keeps every depth layer
 // and the steps fit their compromise. The mean, not the median: a levelled view fills what the
 // camera did not see with the mean of what it saw, which leaves the mean and not the median.
-double exposureOffset(const cv::Mat1f& older, const cv::Mat1f& newer, const std::vector<float>& taper,
+double exposureOffset(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
                       const ImageSimilarity& motion, int stride, std::vector<float>& residuals) {
-  const int n = newer.rows;
+  const int n = newer.smooth.rows;
   const InverseMap map(motion, n);
   residuals.clear();
   for (int y = stride / 2 + 1; y < n - 1; y += stride) {
@@ -322,7 +333,7 @@ double exposureOffset(const cv::Mat1f& older, const cv::Mat1f& newer, const std:
       if (!(taper[x] > 0.0f)) continue;
       // residualAt's difference at gain 1 and bias 0, without its symmetric gradient.
       double a = 0.0, ax = 0.0, ay = 0.0;
-      if (olderAt(older, map, x, y, a, ax, ay)) residuals.push_back(static_cast<float>(newer(y, x) - a));
+      if (olderAt(older, newer, map, x, y, a, ax, ay)) residuals.push_back(static_cast<float>(newer.smooth(y, x) - a));
     }
   }
   if (residuals.size() < kSimilarityParameters * 10u) return 0.0;
@@ -379,11 +390,21 @@ class PositionMoments {
 
 }  // namespace
 
-RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance) {
+RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance, const cv::Mat1b& seen) {
   RefinementImage image;
   if (grey.empty()) return image;
+  if (!seen.empty() && seen.size() != grey.size()) {
+    throw InputError("makeRefinementImage: the mask of what the camera saw is not the frame's size");
+  }
   image.noise_variance = std::isfinite(noise_variance) && noise_variance > 0.0 ? noise_variance : 0.0;
   cv::GaussianBlur(grey, image.smooth, cv::Size(kSmoothingTaps, kSmoothingTaps), kSmoothingSigma, kSmoothingSigma, cv::BORDER_REFLECT);
+  if (!seen.empty() && cv::countNonZero(seen) < static_cast<int>(seen.total())) {
+    // A smoothed pixel mixes its neighbours within half the kernel, and the newer frame's
+    // gradient (a central difference) reads one pixel further.
+    const int reach = kSmoothingTaps / 2 + 1;
+    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * reach + 1, 2 * reach + 1));
+    cv::erode(seen, image.seen, kernel);  // beyond the frame's edge counts as seen: bilinear bounds it
+  }
   return image;
 }
 
@@ -393,7 +414,9 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
                                       const std::vector<cv::Point2d>& other_layers) {
   const int n = newer.smooth.rows;
   if (older.empty() || newer.empty() || older.smooth.size() != newer.smooth.size() ||
-      static_cast<int>(taper.size()) != n || newer.smooth.cols != n || stride < 1) {
+      static_cast<int>(taper.size()) != n || newer.smooth.cols != n || stride < 1 ||
+      (!older.seen.empty() && older.seen.size() != older.smooth.size()) ||
+      (!newer.seen.empty() && newer.seen.size() != newer.smooth.size())) {
     throw InputError("refineSimilarity: frames or taper of different sizes");
   }
   SimilarityRefinement out;
@@ -403,16 +426,16 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   std::vector<float> scratch;
   // The exposure's offset on the steps' grid: on the sparser one its estimate is noisy enough to
   // move the first step's robust weights on frames without any.
-  double bias = exposureOffset(older.smooth, newer.smooth, taper, start, stride, scratch);
+  double bias = exposureOffset(older, newer, taper, start, stride, scratch);
   const double bias_start = bias;
   // The blocks are chosen at the start: after a step, which fits the layers' compromise, the other
   // layers' shifts fit the blocks less well than the start's did.
-  const BlockMask blocks = followedLayerBlocks(older.smooth, newer.smooth, taper, start, other_layers, bias, stride);
+  const BlockMask blocks = followedLayerBlocks(older, newer, taper, start, other_layers, bias, stride);
   out.dropped_blocks = blocks.dropped();
   // The residuals' scale before and after, on a sparser grid (the start's only sets the first
   // step's robust weights).
   const int sparse = 2 * stride;
-  double sigma = robustSigma(older.smooth, newer.smooth, taper, blocks, start, gain, bias, sparse, scratch, nullptr);
+  double sigma = robustSigma(older, newer, taper, blocks, start, gain, bias, sparse, scratch, nullptr);
   if (!(sigma > 0.0)) return out;
   out.residual_start = sigma;
   const double sigma_start = sigma;
@@ -432,7 +455,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       for (int x = stride / 2 + 1; x < n - 1; x += stride) {
         const float w_taper = wy * taper[x];
         if (!(w_taper > 0.0f) || !blocks.kept(x, y)) continue;
-        const PixelResidual p = residualAt(older.smooth, newer.smooth, map, gain, bias, x, y);
+        const PixelResidual p = residualAt(older, newer, map, gain, bias, x, y);
         if (!p.inside) continue;
         scratch.push_back(static_cast<float>(std::fabs(p.r)));
         const double u = p.r / limit;
@@ -494,10 +517,10 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     out.converged = std::fabs(step[0]) < kAngleTolerance && std::fabs(step[1]) < kAngleTolerance &&
                     std::fabs(step[2]) < kShiftTolerance && std::fabs(step[3]) < kShiftTolerance;
   }
-  out.residual_end = robustSigma(older.smooth, newer.smooth, taper, blocks, current, gain, bias, sparse, scratch, &out.pixels);
+  out.residual_end = robustSigma(older, newer, taper, blocks, current, gain, bias, sparse, scratch, &out.pixels);
   out.similarity = current;
   if (out.residual_end >= 0.0) out.loss_end = tukeyLoss(scratch, sigma_start);
-  const LossChange change = lossChange(older.smooth, newer.smooth, taper, blocks, start, 1.0, bias_start, current,
+  const LossChange change = lossChange(older, newer, taper, blocks, start, 1.0, bias_start, current,
                                        gain, bias, sparse, sigma_start);
   if (change.valid) {
     out.loss_change = change.mean;

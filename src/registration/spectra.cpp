@@ -184,6 +184,10 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
                      std::to_string(image.grey.rows) + ", expected " + std::to_string(n) + "x" +
                      std::to_string(n));
   }
+  if (!image.seen.empty() && image.seen.size() != image.grey.size()) {
+    throw InputError("prepared image: the mask of what the camera saw is " + std::to_string(image.seen.cols) + "x" +
+                     std::to_string(image.seen.rows) + ", the image " + std::to_string(n) + "x" + std::to_string(n));
+  }
   FrameSpectra frame;
   frame.grey = image.grey.isContinuous() ? image.grey : image.grey.clone();
   // Float frames keep their values, and single-precision spectra overflow (or the normalised
@@ -219,7 +223,7 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
     for (const float t : context_->window().taper()) taper_energy += static_cast<double>(t) * t;
     const double noise_variance =
         taper_energy > 0.0 ? frame.noise_power / (taper_energy * taper_energy) : 0.0;
-    frame.refinement = makeRefinementImage(frame.grey, noise_variance);
+    frame.refinement = makeRefinementImage(frame.grey, noise_variance, image.seen);
   }
   upperHalfMagnitude(frame.spectrum, context_->highPass(), magnitude_);
   cv::Mat1f log_polar = fft.inPlaceInput(frame.log_polar_spectrum);

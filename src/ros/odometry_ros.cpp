@@ -467,8 +467,10 @@ void OdometryRos::process(const InputFrame& frame) {
   // A tilted frame becomes a level camera's view (lens undone in the same step); else the
   // rectification of the working frame.
   const std::optional<CameraTilt> tilt = parameters_.use_imu ? tiltAt(frame) : std::nullopt;
-  if (tilt && nadir_) {
-    image = nadir_->apply(image, nadirFromOptical(*tilt));
+  const bool levelled = tilt && nadir_;
+  PreparedImage level_view;
+  if (levelled) {
+    level_view = nadir_->prepare(image, nadirFromOptical(*tilt));
   } else if (undistorter_) {
     image = rectifyToWorkingFrame(*undistorter_, working_camera_, image);
   }
@@ -481,9 +483,10 @@ void OdometryRos::process(const InputFrame& frame) {
       estimator_->setTurn(*turn, kGyroRateError * (frame.stamp.toSec() - previous_stamp_));
     }
   }
-  if (tilt && nadir_) estimator_->setLevelled();
+  if (levelled) estimator_->setLevelled();
   const auto start = std::chrono::steady_clock::now();
-  const std::optional<Estimate> estimate = estimator_->push(image, frame.stamp.toSec());
+  const std::optional<Estimate> estimate =
+      levelled ? estimator_->push(level_view, frame.stamp.toSec()) : estimator_->push(image, frame.stamp.toSec());
   if (estimate) previous_stamp_ = frame.stamp.toSec();
   last_processing_ms_ =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -311,7 +311,7 @@ int main(int argc, char** argv) {
           if (attitudes) {
             frame.tilt = oefmt::cameraTiltAt(*attitudes, frame.stamp, camera_in_imu);
             if (frame.tilt) {
-              frame.spectra = builder.build(nadir->apply(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
+              frame.spectra = builder.build(nadir->prepare(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
               return;
             }
             ++*unlevelled;  // no attitude at this stamp: the frame is taken as level

@@ -396,6 +396,18 @@ TEST(ZoomRefinement, FramesOfDifferentSizesAreAnError) {
   EXPECT_THROW(refineSimilarity(small, large, ImageSimilarity{}, taper, 2, 1), InputError);
   EXPECT_THROW(refineSimilarity(large, large, ImageSimilarity{}, std::vector<float>(64, 1.0f), 2, 1),
                InputError);
+  // A mask of what the camera saw must cover the frame, made here or handed in.
+  EXPECT_THROW(makeRefinementImage(cv::Mat1f(128, 128, 1.0f), 0.0, cv::Mat1b(64, 64, 255)), InputError);
+  RefinementImage masked = large;
+  masked.seen = cv::Mat1b(64, 64, 255);
+  EXPECT_THROW(refineSimilarity(large, masked, ImageSimilarity{}, taper, 2, 1), InputError);
+  RegistrationConfig config;
+  config.size = 128;
+  config.fft_planning = FftPlanning::kEstimate;
+  Registrar registrar(config);
+  PreparedImage image = prepareImage(cv::Mat1f(128, 128, 0.5f), 128);
+  image.seen = cv::Mat1b(64, 128, 255);
+  EXPECT_THROW(registrar.analyse(image), InputError);
 }
 
 TEST(ZoomRefinement, AFlatFrameLeavesTheStartUnchanged) {

@@ -30,6 +30,12 @@ class NadirView {
   cv::Mat1f apply(const cv::Mat& image, const Eigen::Matrix3d& nadir_from_optical,
                   ChannelOrder order = ChannelOrder::kBgr) const;
 
+  /// apply()'s view as the estimator takes it (prepareImage at working_size), with the mask of
+  /// the pixels the camera saw (PreparedImage::seen: neither filled in nor faded; empty when the
+  /// camera saw all of the view). Throws as apply().
+  PreparedImage prepare(const cv::Mat& image, const Eigen::Matrix3d& nadir_from_optical,
+                        ChannelOrder order = ChannelOrder::kBgr) const;
+
  private:
   CameraParameters source_camera_;  // the camera of the (shrunk) grey frame
   cv::Size image_size_;
@@ -37,6 +43,10 @@ class NadirView {
   cv::Matx33d virtual_camera_;
   int working_size_;
   double fade_px_ = 32.0;           // the unseen part's ramp [px]
+
+  // apply(); `seen` (when given) receives the mask prepare() describes.
+  cv::Mat1f render(const cv::Mat& image, const Eigen::Matrix3d& nadir_from_optical, ChannelOrder order,
+                   cv::Mat1b* seen) const;
 };
 
 }  // namespace oefmt

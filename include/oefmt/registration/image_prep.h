@@ -32,6 +32,11 @@ struct PreparedImage {
   /// (the spectra need both); NaN when unknown (an image prepared elsewhere): computed then.
   double mean = std::numeric_limits<double>::quiet_NaN();
   double largest_magnitude = std::numeric_limits<double>::quiet_NaN();
+  /// Non-zero where grey is the camera's own pixel, zero where it was filled in (a levelled
+  /// view's part the camera did not see, and the fade into it: io/nadir_view.h); empty when all
+  /// of it is the camera's. The spectra take the fill; the zoom refinement reads only what both
+  /// frames saw.
+  cv::Mat1b seen;
 };
 
 /// Converts any 1/3/4-channel 8-bit, 16-bit, 32-bit or 64-bit float image to single-channel float.

@@ -14,12 +14,20 @@ struct RefinementImage {
   cv::Mat1f smooth;  ///< the grey image, Gaussian-smoothed
   /// Variance of the grey image's white sensor noise, before the smoothing (0: none known).
   double noise_variance = 0.0;
+  /// Non-zero where `smooth` is made of the camera's own pixels only (a levelled view fills in
+  /// what the camera did not see: io/nadir_view.h); empty when all of it is. The refinement reads
+  /// only pixels both frames saw.
+  cv::Mat1b seen;
 
   bool empty() const { return smooth.empty(); }
 };
 
 /// Smooths `grey`, whose white sensor noise has the variance `noise_variance` (0: unknown).
-RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance = 0.0);
+/// `seen` (empty: all of it) is non-zero where `grey` holds what the camera saw; the result's
+/// mask leaves out what the smoothing and the gradients mix into it from elsewhere. Throws
+/// InputError for a mask of another size than `grey`.
+RefinementImage makeRefinementImage(const cv::Mat1f& grey, double noise_variance = 0.0,
+                                    const cv::Mat1b& seen = cv::Mat1b());
 
 /// A similarity in the registration's convention (PairRegistration): the newer frame B shows the
 /// older A turned by `rotation` (counter-clockwise on screen) and scaled by exp(log_zoom) about
@@ -60,7 +68,8 @@ struct SimilarityRefinement {
   int dropped_blocks = 0;
 };
 
-/// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see, weighted by
+/// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see (inside both,
+/// and seen by both cameras: RefinementImage::seen), weighted by
 /// `taper` (the apodization, on both axes) and by Tukey's biweight at the residuals' robust sigma
 /// (measured before each step, at the residuals' lower quartile), so that a layer moving
 /// otherwise (parallax) or new content counts for little. Every `stride`-th pixel of every
