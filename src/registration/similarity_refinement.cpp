@@ -320,8 +320,7 @@ double gradientNoiseVariance(double older_variance, double newer_variance) {
 // see (every `stride`-th of every `stride`-th row; their differences are left in `residuals`);
 // 0 when too few do. Left to the steps instead, an exposure change larger than the texture's
 // contrast sets the first step's robust scale, under which the biweight keeps every depth layer
-// and the steps fit their compromise. The mean, not the median: a levelled view fills what the
-// camera did not see with the mean of what it saw, which leaves the mean and not the median.
+// and the steps fit their compromise.
 double exposureOffset(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
                       const ImageSimilarity& motion, int stride, std::vector<float>& residuals) {
   const int n = newer.smooth.rows;
