@@ -703,9 +703,14 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   };
   if (!usable02) return followLayer(initial12);  // no loop: the gated measurement
 
+  // Pair 0-2's zoom is its registration's alone. Its zoom vector lies a whole pair's zoom (pair
+  // 1-2's) away from pair 0-1's, a fraction of a bin that the matching locks toward the whole
+  // bin: over weak texture nearly all of it (a climb then reads short), over the default texture
+  // a seventh. Pair 1-2's lies only the change of the zoom rate away, about none in steady flight.
+  // est.pms02 stays a diagnostic.
   PairMotion initial02;
   const PairObservations obs02 = detail::observe(
-      reg02, detail::calibrated(reg02, config.uncertainty), est.pmt02, est.pms02, ref, config,
+      reg02, detail::calibrated(reg02, config.uncertainty), est.pmt02, MatchResult{}, ref, config,
       shift_per_bin, log_zoom_per_bin, double(gap02) / gap01, prior02 ? &*prior02 : nullptr, initial02);
   est.translation_use02 = obs02.translation_use;
   t = Clock::now();
