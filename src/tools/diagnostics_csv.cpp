@@ -85,7 +85,7 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        [](const Estimate& e) { return format("%.4f", e.pms12.value); }},
       {"pms12_sigma", "bins", "sigma of pms12_bins",
        [](const Estimate& e) { return format("%.4f", e.pms12.sigma); }},
-      {"pms02_bins", "bins", "shift of pair 0-2's zoom energy against pair 0-1's",
+      {"pms02_bins", "bins", "shift of pair 0-2's zoom energy against pair 0-1's (reported only: not observed)",
        [](const Estimate& e) { return format("%.4f", e.pms02.value); }},
       {"pms02_sigma", "bins", "sigma of pms02_bins",
        [](const Estimate& e) { return format("%.4f", e.pms02.sigma); }},
