@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "estimation/estimator_measurements.h"
 #include "oefmt/error.h"
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/registration/pattern_matching.h"
@@ -370,13 +371,7 @@ TEST(ZoomRefinement, AWholePairsZoomMatchedOnTheEnergyVectorsLocksTowardTheWhole
   const EstimatorConfig config = test::simulatedFlightConfig(plan);  // as the estimator registers
   Registrar registrar(config.modeRegistration());
   const double per_bin = registrar.logZoomPerBin();
-  const MatchingConfig& matching = config.matching;
-  ShiftMatchOptions shift_options;
-  shift_options.max_shift = matching.shift_range;
-  shift_options.step = matching.shift_step;
-  shift_options.max_normalised_error = matching.max_normalised_error;
-  shift_options.smoothing_sigma = matching.smoothing_sigma;
-  shift_options.sigma_floor = matching.shift_sigma_floor;
+  const ShiftMatchOptions shift_options = detail::shiftOptions(config.matching);  // the estimator's
   const auto logZoom = [&](std::size_t from, std::size_t to) {  // the truth: the altitudes' ratio
     return std::log(plan.poses[from].position[2] / plan.poses[to].position[2]);
   };
