@@ -196,7 +196,8 @@ struct Estimator::State {
   // est.measured12 and est.vouched_length set.
   std::optional<PairMotion> corroboratedStep(Estimate& est) const;
   // Where the layer memory cannot vouch: the followed layer's own peak within `agreement` [px]
-  // of the steady length (energy vector, else the highest correlation peak) [px], or none.
+  // of the steady length (a layer of the energy vector, tracking.layer_min_fraction of its
+  // maximum, else the highest correlation peak) [px], or none.
   std::optional<double> followedLayerAtSteadyLength(const PairRegistration& r, double steady,
                                                     double agreement) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
@@ -856,7 +857,7 @@ std::optional<double> Estimator::State::followedLayerAtSteadyLength(const PairRe
   if (shift_per_bin > 0.0) {
     if (const std::optional<double> bin = peakNear(r.translation_energy, steady / shift_per_bin,
                                                    agreement / shift_per_bin,
-                                                   config.tracking.steady_layer_min_fraction)) {
+                                                   config.tracking.layer_min_fraction)) {
       return *bin * shift_per_bin;
     }
   }

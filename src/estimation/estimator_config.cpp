@@ -154,7 +154,9 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
                       "window around the prediction where the followed layer's translation energy "
                       "peak is searched"),
       numberParameter("tracking.layer_min_fraction", t.layer_min_fraction, "", closedRange(0.0, 1.0),
-                      "that peak must reach this fraction of the translation energy maximum"),
+                      "a translation energy peak is a depth layer (the followed one in that window, or "
+                      "the one that carries a pair too weak to register alone at the predicted "
+                      "length) when it reaches this fraction of the maximum"),
       numberParameter("tracking.steady_layer_min_fraction", t.steady_layer_min_fraction, "",
                       closedRange(0.0, 1.0),
                       "a step off steady speed by more than layer_gate moves to a translation energy "

@@ -93,5 +93,17 @@ TEST(CorroboratedSteps, BeforeAnyRatioHeldTheFollowedLayersOwnPeakVouches) {
   EXPECT_GE(weak_tracked, 1);
 }
 
+// The same flight from its first frame: eight frames in, the roofs' peak stands twenty times
+// higher than the ground's, the followed layer, which is still a layer of the energy vector
+// (tracking.layer_min_fraction of its maximum) at the predicted length.
+TEST(CorroboratedSteps, AFollowedLayerFarBelowTheHighestOneStillVouches) {
+  sim::FlightOptions options = roofLine();
+  options.seed = 34;
+  int weak_tracked = 0;
+  StampedTrajectory estimate, truth;
+  ASSERT_NO_FATAL_FAILURE(flyCheckingWeakPairs(test::plannedFlight(options, 12), weak_tracked, estimate, truth));
+  EXPECT_GE(weak_tracked, 1);
+}
+
 }  // namespace
 }  // namespace oefmt
