@@ -80,6 +80,16 @@ const cv::Mat1f& flightTexture() {
   return texture;
 }
 
+sim::FlightOptions weakTextureFlight(sim::TrackShape shape, unsigned seed) {
+  sim::FlightOptions options;
+  options.track.shape = shape;
+  options.contrast = 10.0;
+  options.sensor.noise = 5.0 / 255.0;
+  options.sensor.flicker = 0.1;
+  options.seed = seed;
+  return options;
+}
+
 sim::FlightPlan plannedFlight(const sim::FlightOptions& options, int frames) {
   sim::FlightPlan plan = sim::planFlight(options);
   plan.poses.resize(frames);

@@ -55,6 +55,10 @@ Flight renderTwoLayerFlight(const cv::Mat1f& ground, const cv::Mat1f& roofs, con
 /// The scene texture of the flight tests (2048 x 2048, cells, seeded).
 const cv::Mat1f& flightTexture();
 
+/// The weakest texture the estimator is asked to track: grey std 10 of 255, sensor noise of 5 grey
+/// levels and a brightness flicker of +-10 % between frames, over the simulator's default scene.
+sim::FlightOptions weakTextureFlight(sim::TrackShape shape, unsigned seed);
+
 /// The simulator's plan for `options`, cut to its first `frames` frames.
 sim::FlightPlan plannedFlight(const sim::FlightOptions& options, int frames);
 

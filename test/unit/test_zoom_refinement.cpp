@@ -282,12 +282,7 @@ TEST(ZoomRefinement, LeavingTheOtherLayersBlocksOutSteadiesAWeakTexturesZoom) {
   // the biweight keeps the tops and the steps fit a compromise that reads a zoom where the tops
   // happen to lie. The tops' shifts (the translation energy vector's other peaks) tell their
   // blocks apart; left out, they no longer pull the zoom.
-  sim::FlightOptions options;
-  options.track.shape = sim::TrackShape::kCircle;
-  options.contrast = 10.0;
-  options.sensor.noise = 5.0 / 255.0;
-  options.sensor.flicker = 0.1;
-  options.seed = 24;
+  const sim::FlightOptions options = test::weakTextureFlight(sim::TrackShape::kCircle, 24);
   const sim::FlightPlan plan = test::plannedFlight(options, 25);
   const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
   RegistrationConfig config;
@@ -359,13 +354,8 @@ TEST(ZoomRefinement, AWholePairsZoomMatchedOnTheEnergyVectorsLocksTowardTheWhole
   // fraction of a bin (about 3 % here), while a registration's refined zoom reads such a
   // fraction whole (within 1 %). A line
   // climbing from about 6 to 11 m: a third of a bin per frame over its first frames.
-  sim::FlightOptions options;
-  options.track.shape = sim::TrackShape::kLine;
+  sim::FlightOptions options = test::weakTextureFlight(sim::TrackShape::kLine, 26);
   options.track.climb = 5.0;
-  options.contrast = 10.0;
-  options.sensor.noise = 5.0 / 255.0;
-  options.sensor.flicker = 0.1;
-  options.seed = 26;
   const sim::FlightPlan plan = test::plannedFlight(options, 23);
   const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
   const EstimatorConfig config = test::simulatedFlightConfig(plan);  // as the estimator registers
