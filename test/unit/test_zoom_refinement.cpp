@@ -352,8 +352,8 @@ TEST(ZoomRefinement, AWholePairsZoomMatchedOnTheEnergyVectorsLocksTowardTheWhole
   // vector lies pair 1-2's whole zoom away from pair 0-1's, and on weak texture (grey std 10,
   // noise of 5 grey levels, flicker) the pattern matching of the two reads little of that
   // fraction of a bin (about 3 % here), while a registration's refined zoom reads such a
-  // fraction whole (within 1 %). A line
-  // climbing from about 6 to 11 m: a third of a bin per frame over its first frames.
+  // fraction whole (within 1 %). A line climbing from about 6 to 11 m: a third of a bin per
+  // frame over its first frames.
   sim::FlightOptions options = test::weakTextureFlight(sim::TrackShape::kLine, 26);
   options.track.climb = 5.0;
   const sim::FlightPlan plan = test::plannedFlight(options, 23);
