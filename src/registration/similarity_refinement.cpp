@@ -93,6 +93,26 @@ bool olderAt(const RefinementImage& older, const RefinementImage& newer, const I
   return r0[x0] != 0 && r0[x0 + 1] != 0 && r1[x0] != 0 && r1[x0 + 1] != 0;
 }
 
+// The older frame's bilinear value at (sx, sy), where olderAt would read one (inside the frame,
+// its four pixels seen); without the derivatives.
+bool olderValue(const RefinementImage& older, double sx, double sy, double& value) {
+  const cv::Mat1f& image = older.smooth;
+  if (!(sx >= 1.0 && sy >= 1.0 && sx < image.cols - 2.0 && sy < image.rows - 2.0)) return false;
+  const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+  if (!older.seen.empty()) {
+    const unsigned char* s0 = older.seen[y0];
+    const unsigned char* s1 = older.seen[y0 + 1];
+    if (s0[x0] == 0 || s0[x0 + 1] == 0 || s1[x0] == 0 || s1[x0 + 1] == 0) return false;
+  }
+  const double tx = sx - x0, ty = sy - y0;
+  const float* r0 = image[y0];
+  const float* r1 = image[y0 + 1];
+  const double top = r0[x0] + tx * (r0[x0 + 1] - r0[x0]);
+  const double bottom = r1[x0] + tx * (r1[x0 + 1] - r1[x0]);
+  value = top + ty * (bottom - top);
+  return true;
+}
+
 PixelResidual residualAt(const RefinementImage& older, const RefinementImage& newer, const InverseMap& map,
                          double gain, double bias, int x, int y) {
   PixelResidual p;
@@ -167,13 +187,18 @@ class BlockMask {
  public:
   explicit BlockMask(int n) : n_(n), kept_(kLayerBlocks * kLayerBlocks, 1) {}
   int index(int x, int y) const { return (y * kLayerBlocks / n_) * kLayerBlocks + x * kLayerBlocks / n_; }
-  bool kept(int x, int y) const { return kept_[index(x, y)] != 0; }
+  bool kept(int x, int y) const {
+    return kept_[index(x, y)] != 0 && (dropped_pixels_.empty() || dropped_pixels_(y, x) == 0);
+  }
   void drop(int block) { kept_[block] = 0; }
   int dropped() const { return static_cast<int>(std::count(kept_.begin(), kept_.end(), 0)); }
+  // Pixels left out one by one (non-zero: left out), over the blocks' choice.
+  void dropPixels(cv::Mat1b dropped) { dropped_pixels_ = std::move(dropped); }
 
  private:
   int n_;
   std::vector<unsigned char> kept_;
+  cv::Mat1b dropped_pixels_;
 };
 
 // The blocks where the start's shift explains the frames no worse than the shift of any other
@@ -233,6 +258,152 @@ BlockMask followedLayerBlocks(const RefinementImage& older, const RefinementImag
     }
   }
   return blocks;
+}
+
+// The depth layers' test of followedLayerBlocks again, on a finer grain: a block holds parts of
+// several surfaces wherever layers meet, a cell of kPixelCell x kPixelCell pixels of the sparse
+// grid (about 27 px at N = 512) mostly one. A cell is tested on kPixelSamples samples around its
+// centre, kPixelReach px to each side every kPixelStep px (the frames are smoothed over about a
+// pixel, so their noises are nearly independent), and left out when another shift along the
+// motion explains them better by kLayerEvidence standard errors. Walls and slopes lie between the
+// layers, their shift varying with their height: besides the other layers' shifts,
+// kShiftsBetweenLayers evenly spaced between the followed layer's and each other's are tried, or a
+// wall would fit the followed layer no worse than any one layer's shift, and its texture, which
+// turns as the camera passes it, would pull the rotation.
+constexpr int kPixelCell = 3;
+constexpr int kPixelReach = 4;
+constexpr int kPixelStep = 2;
+constexpr int kPixelSamples = (2 * kPixelReach / kPixelStep + 1) * (2 * kPixelReach / kPixelStep + 1);
+constexpr int kShiftsBetweenLayers = 3;
+// Shifts closer than this to the start's [px] are not tried: no other surface.
+constexpr double kMinShiftApartPx = 1.0;
+// After this many samples a shift that fits clearly worse (most shifts at most cells) is not
+// followed further: the test's time goes to the shifts that may win.
+constexpr int kEarlyLook = 10;
+
+// The shifts the cells' test tries besides the start's: the other layers' and those between.
+std::vector<cv::Point2d> triedShifts(const cv::Point2d& followed, const std::vector<cv::Point2d>& other_layers) {
+  std::vector<cv::Point2d> shifts;
+  for (const cv::Point2d& layer : other_layers) {
+    for (int j = 1; j <= kShiftsBetweenLayers + 1; ++j) {
+      const cv::Point2d shift = followed + (layer - followed) * (j / (kShiftsBetweenLayers + 1.0));
+      if (cv::norm(shift - followed) > kMinShiftApartPx) shifts.push_back(shift);
+    }
+  }
+  return shifts;
+}
+
+// Bilinear value of `image` at (x, y), the caller having checked that (x, y) and (x + 1, y + 1)
+// lie inside.
+inline double bilinearInside(const cv::Mat1f& image, double x, double y) {
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double tx = x - x0, ty = y - y0;
+  const float* r0 = image[y0] + x0;
+  const float* r1 = r0 + image.step1();
+  const double top = r0[0] + tx * (r0[1] - r0[0]);
+  const double bottom = r1[0] + tx * (r1[1] - r1[0]);
+  return top + ty * (bottom - top);
+}
+
+// The sparse grid's pixels (non-zero in the returned mask) of the cells in kept blocks that one of
+// `shifts` (at the start's rotation and zoom) explains better than the start's; `dropped` counts
+// the cells.
+cv::Mat1b otherSurfacePixels(const RefinementImage& older, const RefinementImage& newer,
+                             const std::vector<float>& taper, const BlockMask& blocks, const ImageSimilarity& start,
+                             const std::vector<cv::Point2d>& shifts, double bias, int stride, int& dropped) {
+  const int n = newer.smooth.rows;
+  cv::Mat1b mask(n, n, static_cast<unsigned char>(0));
+  dropped = 0;
+  if (shifts.empty()) return mask;
+  const InverseMap map(start, n);
+  // A newer pixel's position in the older frame moves by I (d_start - d) under another shift d,
+  // and by I o for a sample o px from the pixel: both the same everywhere.
+  std::vector<cv::Point2d> shift_offsets;
+  for (const cv::Point2d& d : shifts) {
+    const double dx = map.tx - d.x, dy = map.ty - d.y;
+    shift_offsets.emplace_back(map.i00 * dx + map.i01 * dy, map.i10 * dx + map.i11 * dy);
+  }
+  struct Sample {
+    int dx, dy;
+    double ox, oy;
+  };
+  std::vector<Sample> samples;
+  double span = 1.0;  // how far a sample lies from the cell's centre in the older frame, plus a pixel
+  for (int dy = -kPixelReach; dy <= kPixelReach; dy += kPixelStep) {
+    for (int dx = -kPixelReach; dx <= kPixelReach; dx += kPixelStep) {
+      const Sample o{dx, dy, map.i00 * dx + map.i01 * dy, map.i10 * dx + map.i11 * dy};
+      samples.push_back(o);
+      span = std::max({span, std::fabs(o.ox) + 1.0, std::fabs(o.oy) + 1.0});
+    }
+  }
+  // Where the samples' bounding box lies inside the older frame and no pixel is unseen, they are
+  // read without a check each.
+  const auto clear = [&](double x, double y) {
+    return older.seen.empty() && x - span >= 1.0 && y - span >= 1.0 && x + span < n - 2.0 && y + span < n - 2.0;
+  };
+  const auto olderSample = [&](double x, double y, bool checked, double& value) {
+    if (checked) {
+      value = bilinearInside(older.smooth, x, y);
+      return true;
+    }
+    return olderValue(older, x, y, value);
+  };
+  double own[kPixelSamples];
+  double newer_value[kPixelSamples];
+  const int first = stride / 2 + 1;
+  const int cell_span = (kPixelCell - 1) * stride;
+  for (int y0 = first; y0 < n - 1; y0 += kPixelCell * stride) {
+    const int y = y0 + cell_span / 2;  // the cell's centre
+    if (y - kPixelReach < 1 || y + kPixelReach > n - 2 || !(taper[y] > 0.0f)) continue;
+    for (int x0 = first; x0 < n - 1; x0 += kPixelCell * stride) {
+      const int x = x0 + cell_span / 2;
+      if (x - kPixelReach < 1 || x + kPixelReach > n - 2 || !(taper[x] > 0.0f) || !blocks.kept(x, y)) continue;
+      const double qx = x - map.tx - map.c, qy = y - map.ty - map.c;
+      const double sx = map.c + map.i00 * qx + map.i01 * qy, sy = map.c + map.i10 * qx + map.i11 * qy;
+      const bool own_clear = clear(sx, sy) && newer.seen.empty();
+      bool inside = true;
+      for (int k = 0; k < kPixelSamples && inside; ++k) {
+        const Sample& o = samples[k];
+        double a = 0.0;
+        inside = (newer.seen.empty() || newer.seen(y + o.dy, x + o.dx) != 0) &&
+                 olderSample(sx + o.ox, sy + o.oy, own_clear, a);
+        newer_value[k] = newer.smooth(y + o.dy, x + o.dx) - bias;
+        own[k] = newer_value[k] - a;
+      }
+      if (!inside) continue;  // near an edge or the unseen: the blocks' choice stands
+      for (const cv::Point2d& offset : shift_offsets) {
+        const double bx = sx + offset.x, by = sy + offset.y;
+        const bool shift_clear = clear(bx, by);
+        double sum = 0.0, sum2 = 0.0;
+        int k = 0;
+        for (; k < kPixelSamples; ++k) {
+          const Sample& o = samples[k];
+          double a = 0.0;
+          if (!olderSample(bx + o.ox, by + o.oy, shift_clear, a)) break;
+          const double other = newer_value[k] - a;
+          const double d = own[k] * own[k] - other * other;
+          sum += d;
+          sum2 += d * d;
+          if (k + 1 == kEarlyLook) {
+            const double mean = sum / kEarlyLook;
+            const double variance = std::max(sum2 / kEarlyLook - mean * mean, 0.0);
+            if (mean < -kLayerEvidence * std::sqrt(variance / kEarlyLook)) break;
+          }
+        }
+        if (k < kPixelSamples) continue;
+        const double mean = sum / kPixelSamples;
+        const double variance = std::max(sum2 / kPixelSamples - mean * mean, 0.0);
+        if (mean > kLayerEvidence * std::sqrt(variance / kPixelSamples)) {
+          for (int yy = y0; yy <= std::min(y0 + cell_span, n - 1); yy += stride) {
+            for (int xx = x0; xx <= std::min(x0 + cell_span, n - 1); xx += stride) mask(yy, xx) = 1;
+          }
+          ++dropped;
+          break;
+        }
+      }
+    }
+  }
+  return mask;
 }
 
 // Robust sigma (robustScale) over every `stride`-th pixel inside both frames and in a kept
@@ -429,8 +600,12 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   const double bias_start = bias;
   // The blocks are chosen at the start: after a step, which fits the layers' compromise, the other
   // layers' shifts fit the blocks less well than the start's did.
-  const BlockMask blocks = followedLayerBlocks(older, newer, taper, start, other_layers, bias, stride);
+  BlockMask blocks = followedLayerBlocks(older, newer, taper, start, other_layers, bias, stride);
   out.dropped_blocks = blocks.dropped();
+  if (!other_layers.empty()) {
+    blocks.dropPixels(otherSurfacePixels(older, newer, taper, blocks, start, triedShifts(start.translation, other_layers),
+                                         bias, stride, out.dropped_cells));
+  }
   // The residuals' scale before and after, on a sparser grid (the start's only sets the first
   // step's robust weights).
   const int sparse = 2 * stride;

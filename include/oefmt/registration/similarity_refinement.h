@@ -66,6 +66,9 @@ struct SimilarityRefinement {
   cv::Matx33d rotation_stretch_covariance = cv::Matx33d::zeros();
   /// Blocks of the image (of 64) left out because another depth layer's shift fits them better.
   int dropped_blocks = 0;
+  /// Cells of the kept blocks (3 x 3 pixels of the sparse grid each) left out because another
+  /// shift along the motion fits them better.
+  int dropped_cells = 0;
 };
 
 /// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see (inside both,
@@ -81,7 +84,11 @@ struct SimilarityRefinement {
 /// image (8 x 8) that one of them explains better than the start's shift, by three standard
 /// errors of the mean difference of the squared residuals over the block's pixels, is left out,
 /// so that the steps measure the followed layer's motion also where the texture is too weak
-/// against the noise for the biweight to tell another layer's pixels from noisy ones.
+/// against the noise for the biweight to tell another layer's pixels from noisy ones. The same
+/// test then runs on each cell of 3 x 3 grid pixels of the kept blocks, on 25 samples around its
+/// centre, against the other layers' shifts and three evenly spaced between the start's and each
+/// of them: where layers meet a block holds several surfaces, and walls or slopes, whose shift
+/// varies with their height, fit no one layer's shift better than the followed one's.
 SimilarityRefinement refineSimilarity(const RefinementImage& older, const RefinementImage& newer,
                                       const ImageSimilarity& start, const std::vector<float>& taper,
                                       int iterations, int stride, bool fit_stretch = false,
