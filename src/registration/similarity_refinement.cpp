@@ -93,23 +93,30 @@ bool olderAt(const RefinementImage& older, const RefinementImage& newer, const I
   return r0[x0] != 0 && r0[x0 + 1] != 0 && r1[x0] != 0 && r1[x0 + 1] != 0;
 }
 
+// Bilinear value of `image` at (x, y), the caller having checked that (x, y) and (x + 1, y + 1)
+// lie inside.
+inline double bilinearInside(const cv::Mat1f& image, double x, double y) {
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const double tx = x - x0, ty = y - y0;
+  const float* r0 = image[y0] + x0;
+  const float* r1 = r0 + image.step1();
+  const double top = r0[0] + tx * (r0[1] - r0[0]);
+  const double bottom = r1[0] + tx * (r1[1] - r1[0]);
+  return top + ty * (bottom - top);
+}
+
 // The older frame's bilinear value at (sx, sy), where olderAt would read one (inside the frame,
 // its four pixels seen); without the derivatives.
 bool olderValue(const RefinementImage& older, double sx, double sy, double& value) {
   const cv::Mat1f& image = older.smooth;
   if (!(sx >= 1.0 && sy >= 1.0 && sx < image.cols - 2.0 && sy < image.rows - 2.0)) return false;
-  const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
   if (!older.seen.empty()) {
+    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
     const unsigned char* s0 = older.seen[y0];
     const unsigned char* s1 = older.seen[y0 + 1];
     if (s0[x0] == 0 || s0[x0 + 1] == 0 || s1[x0] == 0 || s1[x0 + 1] == 0) return false;
   }
-  const double tx = sx - x0, ty = sy - y0;
-  const float* r0 = image[y0];
-  const float* r1 = image[y0 + 1];
-  const double top = r0[x0] + tx * (r0[x0 + 1] - r0[x0]);
-  const double bottom = r1[x0] + tx * (r1[x0 + 1] - r1[x0]);
-  value = top + ty * (bottom - top);
+  value = bilinearInside(image, sx, sy);
   return true;
 }
 
@@ -182,6 +189,14 @@ constexpr double kLayerEvidence = 3.0;
 // Pixels a block needs for the test.
 constexpr int kLayerBlockPixels = 10;
 
+// Whether the mean of `count` paired differences (their sum and sum of squares) lies above zero
+// by more than `evidence` of its standard errors.
+bool clearlyPositive(double sum, double sum2, int count, double evidence) {
+  const double mean = sum / count;
+  const double variance = std::max(sum2 / count - mean * mean, 0.0);
+  return mean > evidence * std::sqrt(variance / count);
+}
+
 // Which blocks of the newer frame the refinement reads.
 class BlockMask {
  public:
@@ -249,9 +264,7 @@ BlockMask followedLayerBlocks(const RefinementImage& older, const RefinementImag
     for (std::size_t i = 0; i < others.size(); ++i) {
       const Sums& s = sums[static_cast<std::size_t>(block) * others.size() + i];
       if (s.count < kLayerBlockPixels) continue;
-      const double mean = s.d / s.count;
-      const double variance = std::max(s.d2 / s.count - mean * mean, 0.0);
-      if (mean > kLayerEvidence * std::sqrt(variance / s.count)) {
+      if (clearlyPositive(s.d, s.d2, s.count, kLayerEvidence)) {
         blocks.drop(block);
         break;
       }
@@ -291,18 +304,6 @@ std::vector<cv::Point2d> triedShifts(const cv::Point2d& followed, const std::vec
     }
   }
   return shifts;
-}
-
-// Bilinear value of `image` at (x, y), the caller having checked that (x, y) and (x + 1, y + 1)
-// lie inside.
-inline double bilinearInside(const cv::Mat1f& image, double x, double y) {
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const double tx = x - x0, ty = y - y0;
-  const float* r0 = image[y0] + x0;
-  const float* r1 = r0 + image.step1();
-  const double top = r0[0] + tx * (r0[1] - r0[0]);
-  const double bottom = r1[0] + tx * (r1[1] - r1[0]);
-  return top + ty * (bottom - top);
 }
 
 // The sparse grid's pixels (non-zero in the returned mask) of the cells in kept blocks that one of
@@ -384,16 +385,11 @@ cv::Mat1b otherSurfacePixels(const RefinementImage& older, const RefinementImage
           const double d = own[k] * own[k] - other * other;
           sum += d;
           sum2 += d * d;
-          if (k + 1 == kEarlyLook) {
-            const double mean = sum / kEarlyLook;
-            const double variance = std::max(sum2 / kEarlyLook - mean * mean, 0.0);
-            if (mean < -kLayerEvidence * std::sqrt(variance / kEarlyLook)) break;
-          }
+          // The start's shift already fits clearly better: this one will not win.
+          if (k + 1 == kEarlyLook && clearlyPositive(-sum, sum2, kEarlyLook, kLayerEvidence)) break;
         }
         if (k < kPixelSamples) continue;
-        const double mean = sum / kPixelSamples;
-        const double variance = std::max(sum2 / kPixelSamples - mean * mean, 0.0);
-        if (mean > kLayerEvidence * std::sqrt(variance / kPixelSamples)) {
+        if (clearlyPositive(sum, sum2, kPixelSamples, kLayerEvidence)) {
           for (int yy = y0; yy <= std::min(y0 + cell_span, n - 1); yy += stride) {
             for (int xx = x0; xx <= std::min(x0 + cell_span, n - 1); xx += stride) mask(yy, xx) = 1;
           }
