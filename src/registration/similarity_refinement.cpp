@@ -197,23 +197,38 @@ bool clearlyPositive(double sum, double sum2, int count, double evidence) {
   return mean > evidence * std::sqrt(variance / count);
 }
 
-// Which blocks of the newer frame the refinement reads.
+// Which parts of the newer frame the refinement reads: the depth layers' test's blocks, and
+// within the kept ones the cells that a finer test may leave out (areas of the frame).
 class BlockMask {
  public:
   explicit BlockMask(int n) : n_(n), kept_(kLayerBlocks * kLayerBlocks, 1) {}
   int index(int x, int y) const { return (y * kLayerBlocks / n_) * kLayerBlocks + x * kLayerBlocks / n_; }
   bool kept(int x, int y) const {
-    return kept_[index(x, y)] != 0 && (dropped_pixels_.empty() || dropped_pixels_(y, x) == 0);
+    return kept_[index(x, y)] != 0 && (dropped_cells_.empty() || dropped_cells_[cell(x, y)] == 0);
   }
   void drop(int block) { kept_[block] = 0; }
   int dropped() const { return static_cast<int>(std::count(kept_.begin(), kept_.end(), 0)); }
-  // Pixels left out one by one (non-zero: left out), over the blocks' choice.
-  void dropPixels(cv::Mat1b dropped) { dropped_pixels_ = std::move(dropped); }
+  // Square cells of `size` px from `origin` (in x and y), none left out yet.
+  void cellGrid(int origin, int size) {
+    cell_origin_ = origin;
+    cell_size_ = size;
+    cells_per_side_ = (n_ - origin + size - 1) / size;
+    dropped_cells_.assign(static_cast<std::size_t>(cells_per_side_ * cells_per_side_), 0);
+  }
+  // Leaves out the cell that holds the pixel (x, y).
+  void dropCell(int x, int y) { dropped_cells_[cell(x, y)] = 1; }
 
  private:
+  std::size_t cell(int x, int y) const {
+    const int cx = std::clamp((x - cell_origin_) / cell_size_, 0, cells_per_side_ - 1);
+    const int cy = std::clamp((y - cell_origin_) / cell_size_, 0, cells_per_side_ - 1);
+    return static_cast<std::size_t>(cy * cells_per_side_ + cx);
+  }
+
   int n_;
   std::vector<unsigned char> kept_;
-  cv::Mat1b dropped_pixels_;
+  int cell_origin_ = 0, cell_size_ = 1, cells_per_side_ = 0;
+  std::vector<unsigned char> dropped_cells_;
 };
 
 // The blocks where the start's shift explains the frames no worse than the shift of any other
@@ -306,16 +321,18 @@ std::vector<cv::Point2d> triedShifts(const cv::Point2d& followed, const std::vec
   return shifts;
 }
 
-// The sparse grid's pixels (non-zero in the returned mask) of the cells in kept blocks that one of
-// `shifts` (at the start's rotation and zoom) explains better than the start's; `dropped` counts
-// the cells.
-cv::Mat1b otherSurfacePixels(const RefinementImage& older, const RefinementImage& newer,
-                             const std::vector<float>& taper, const BlockMask& blocks, const ImageSimilarity& start,
-                             const std::vector<cv::Point2d>& shifts, double bias, int stride, int& dropped) {
+// Leaves out of `blocks` the cells (of kPixelCell x kPixelCell pixels of the grid every `stride`
+// px) in kept blocks that one of `shifts` (at the start's rotation and zoom) explains better than
+// the start's; returns how many.
+int dropOtherSurfaceCells(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
+                          const ImageSimilarity& start, const std::vector<cv::Point2d>& shifts, double bias,
+                          int stride, BlockMask& blocks) {
   const int n = newer.smooth.rows;
-  cv::Mat1b mask(n, n, static_cast<unsigned char>(0));
-  dropped = 0;
-  if (shifts.empty()) return mask;
+  const int first = stride / 2 + 1;
+  // A cell's area reaches half the grid's spacing beyond its outer pixels.
+  blocks.cellGrid(first - stride / 2, kPixelCell * stride);
+  int dropped = 0;
+  if (shifts.empty()) return dropped;
   const InverseMap map(start, n);
   // A newer pixel's position in the older frame moves by I (d_start - d) under another shift d,
   // and by I o for a sample o px from the pixel: both the same everywhere.
@@ -351,7 +368,6 @@ cv::Mat1b otherSurfacePixels(const RefinementImage& older, const RefinementImage
   };
   double own[kPixelSamples];
   double newer_value[kPixelSamples];
-  const int first = stride / 2 + 1;
   const int cell_span = (kPixelCell - 1) * stride;
   for (int y0 = first; y0 < n - 1; y0 += kPixelCell * stride) {
     const int y = y0 + cell_span / 2;  // the cell's centre
@@ -390,74 +406,34 @@ cv::Mat1b otherSurfacePixels(const RefinementImage& older, const RefinementImage
         }
         if (k < kPixelSamples) continue;
         if (clearlyPositive(sum, sum2, kPixelSamples, kLayerEvidence)) {
-          for (int yy = y0; yy <= std::min(y0 + cell_span, n - 1); yy += stride) {
-            for (int xx = x0; xx <= std::min(x0 + cell_span, n - 1); xx += stride) mask(yy, xx) = 1;
-          }
+          blocks.dropCell(x, y);
           ++dropped;
           break;
         }
       }
     }
   }
-  return mask;
+  return dropped;
 }
 
-// Robust sigma (robustScale) over every `stride`-th pixel inside both frames and in a kept
-// block; negative when too few are.
-double robustSigma(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
-                   const BlockMask& blocks, const ImageSimilarity& motion, double gain, double bias,
-                   int stride, std::vector<float>& scratch, int* count) {
-  const int n = newer.smooth.rows;
-  const InverseMap map(motion, n);
-  scratch.clear();
-  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
-    if (!(taper[y] > 0.0f)) continue;
-    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-      if (!(taper[x] > 0.0f) || !blocks.kept(x, y)) continue;
-      const PixelResidual p = residualAt(older, newer, map, gain, bias, x, y);
-      if (p.inside) scratch.push_back(static_cast<float>(std::fabs(p.r)));
-    }
-  }
-  if (count != nullptr) *count = static_cast<int>(scratch.size());
-  return robustScale(scratch);
-}
-
-struct LossChange {
-  bool valid = false;
-  double mean = 0.0;
-  double sigma = 0.0;  // standard error of the mean
+// The pixels the refinement reads: every `stride`-th of every `stride`-th row where the taper is
+// positive, in a kept block and cell.
+struct GridPixel {
+  int x, y;
+  float taper;
 };
 
-// The change of the biweight loss (at `sigma`) from motion `a` to motion `b` over the pixels of
-// the sparse grid inside both frames at both, and its standard error: the pixels are paired, so
-// the texture's own spread of the loss cancels and what is left is the change's noise.
-LossChange lossChange(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
-                      const BlockMask& blocks, const ImageSimilarity& a, double gain_a, double bias_a,
-                      const ImageSimilarity& b, double gain_b, double bias_b, int stride, double sigma) {
-  const int n = newer.smooth.rows;
-  const InverseMap map_a(a, n), map_b(b, n);
-  const double limit = kTukey * sigma;
-  double sum = 0.0, sum2 = 0.0;
-  int count = 0;
+std::vector<GridPixel> gridPixels(const std::vector<float>& taper, const BlockMask& blocks, int stride) {
+  const int n = static_cast<int>(taper.size());
+  std::vector<GridPixel> pixels;
   for (int y = stride / 2 + 1; y < n - 1; y += stride) {
     if (!(taper[y] > 0.0f)) continue;
     for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-      if (!(taper[x] > 0.0f) || !blocks.kept(x, y)) continue;
-      const PixelResidual pa = residualAt(older, newer, map_a, gain_a, bias_a, x, y);
-      const PixelResidual pb = residualAt(older, newer, map_b, gain_b, bias_b, x, y);
-      if (!pa.inside || !pb.inside) continue;
-      const double d = tukeyRho(pb.r, limit) - tukeyRho(pa.r, limit);
-      sum += d;
-      sum2 += d * d;
-      ++count;
+      const float w = taper[y] * taper[x];
+      if (w > 0.0f && blocks.kept(x, y)) pixels.push_back({x, y, w});
     }
   }
-  LossChange change;
-  if (count < kSimilarityParameters * 10) return change;  // as robustScale
-  change.mean = sum / count;
-  change.sigma = std::sqrt(std::max(sum2 / count - change.mean * change.mean, 0.0) / (count - 1));
-  change.valid = true;
-  return change;
+  return pixels;
 }
 
 // Variance of the noise of the symmetric gradient (refineSimilarity's PixelResidual) when the
@@ -593,19 +569,28 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   // The exposure's offset on the steps' grid: on the sparser one its estimate is noisy enough to
   // move the first step's robust weights on frames without any.
   double bias = exposureOffset(older, newer, taper, start, stride, scratch);
-  const double bias_start = bias;
   // The blocks are chosen at the start: after a step, which fits the layers' compromise, the other
   // layers' shifts fit the blocks less well than the start's did.
   BlockMask blocks = followedLayerBlocks(older, newer, taper, start, other_layers, bias, stride);
   out.dropped_blocks = blocks.dropped();
   if (!other_layers.empty()) {
-    blocks.dropPixels(otherSurfacePixels(older, newer, taper, blocks, start, triedShifts(start.translation, other_layers),
-                                         bias, stride, out.dropped_cells));
+    out.dropped_cells = dropOtherSurfaceCells(older, newer, taper, start, triedShifts(start.translation, other_layers),
+                                              bias, stride, blocks);
   }
-  // The residuals' scale before and after, on a sparser grid (the start's only sets the first
-  // step's robust weights).
-  const int sparse = 2 * stride;
-  double sigma = robustSigma(older, newer, taper, blocks, start, gain, bias, sparse, scratch, nullptr);
+  const std::vector<GridPixel> pixels = gridPixels(taper, blocks, stride);
+  // The residuals at the start, which set the first step's robust weights and scale the loss
+  // that judges the fit, are the first step's residuals too.
+  std::vector<PixelResidual> at_start;
+  at_start.reserve(pixels.size());
+  scratch.clear();
+  {
+    const InverseMap map(start, n);
+    for (const GridPixel& g : pixels) {
+      at_start.push_back(residualAt(older, newer, map, gain, bias, g.x, g.y));
+      if (at_start.back().inside) scratch.push_back(static_cast<float>(std::fabs(at_start.back().r)));
+    }
+  }
+  double sigma = robustScale(scratch);
   if (!(sigma > 0.0)) return out;
   out.residual_start = sigma;
   const double sigma_start = sigma;
@@ -619,37 +604,32 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     PositionMoments moments;
     const double limit = kTukey * sigma;
     scratch.clear();
-    for (int y = stride / 2 + 1; y < n - 1; y += stride) {
-      const float wy = taper[y];
-      if (!(wy > 0.0f)) continue;
-      for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-        const float w_taper = wy * taper[x];
-        if (!(w_taper > 0.0f) || !blocks.kept(x, y)) continue;
-        const PixelResidual p = residualAt(older, newer, map, gain, bias, x, y);
-        if (!p.inside) continue;
-        scratch.push_back(static_cast<float>(std::fabs(p.r)));
-        const double u = p.r / limit;
-        if (!(u * u < 1.0)) continue;
-        const double w = w_taper * (1.0 - u * u) * (1.0 - u * u);
-        // Residual motion u = (delta I + omega J)(x - p) + dd about p = c + d, J v = (v_y, -v_x):
-        // r ~ -g.u + d_gain A + d_bias.
-        const double px = x - map.tx - map.c, py = y - map.ty - map.c;
-        Vector j;
-        j[0] = -(p.gx * py - p.gy * px);  // omega
-        j[1] = -(p.gx * px + p.gy * py);  // delta (log zoom)
-        j[2] = -p.gx;
-        j[3] = -p.gy;
-        j[4] = p.a;
-        j[5] = 1.0;
-        j[6] = -(p.gx * px - p.gy * py);  // stretch a: (px, -py)
-        j[7] = -(p.gx * py + p.gy * px);  // stretch b: (py, px)
-        if (fit_stretch) {
-          accumulate<kParameters>(j, w, p.r, normal, rhs);
-        } else {
-          accumulate<kSimilarityParameters>(j, w, p.r, normal, rhs);
-        }
-        if (gradient_noise > 0.0) moments.add(w, px, py);
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      const GridPixel& g = pixels[i];
+      const PixelResidual p = iteration == 0 ? at_start[i] : residualAt(older, newer, map, gain, bias, g.x, g.y);
+      if (!p.inside) continue;
+      scratch.push_back(static_cast<float>(std::fabs(p.r)));
+      const double u = p.r / limit;
+      if (!(u * u < 1.0)) continue;
+      const double w = g.taper * (1.0 - u * u) * (1.0 - u * u);
+      // Residual motion u = (delta I + omega J)(x - p) + dd about p = c + d, J v = (v_y, -v_x):
+      // r ~ -g.u + d_gain A + d_bias.
+      const double px = g.x - map.tx - map.c, py = g.y - map.ty - map.c;
+      Vector j;
+      j[0] = -(p.gx * py - p.gy * px);  // omega
+      j[1] = -(p.gx * px + p.gy * py);  // delta (log zoom)
+      j[2] = -p.gx;
+      j[3] = -p.gy;
+      j[4] = p.a;
+      j[5] = 1.0;
+      j[6] = -(p.gx * px - p.gy * py);  // stretch a: (px, -py)
+      j[7] = -(p.gx * py + p.gy * px);  // stretch b: (py, px)
+      if (fit_stretch) {
+        accumulate<kParameters>(j, w, p.r, normal, rhs);
+      } else {
+        accumulate<kSimilarityParameters>(j, w, p.r, normal, rhs);
       }
+      if (gradient_noise > 0.0) moments.add(w, px, py);
     }
     if (gradient_noise > 0.0) moments.subtractNoise(gradient_noise, parameters, normal);
     // The next step's scale: this pass's residuals (before its step).
@@ -687,14 +667,31 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     out.converged = std::fabs(step[0]) < kAngleTolerance && std::fabs(step[1]) < kAngleTolerance &&
                     std::fabs(step[2]) < kShiftTolerance && std::fabs(step[3]) < kShiftTolerance;
   }
-  out.residual_end = robustSigma(older, newer, taper, blocks, current, gain, bias, sparse, scratch, &out.pixels);
   out.similarity = current;
+  // The residuals at the refined motion: their scale, their loss at the start's scale, and the
+  // loss's change from the start over the pixels inside at both, paired, so that the texture's
+  // own spread of the loss cancels and what is left is the change's noise.
+  const InverseMap map(current, n);
+  const double limit = kTukey * sigma_start;
+  double sum = 0.0, sum2 = 0.0;
+  int paired = 0;
+  scratch.clear();
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const PixelResidual p = residualAt(older, newer, map, gain, bias, pixels[i].x, pixels[i].y);
+    if (!p.inside) continue;
+    scratch.push_back(static_cast<float>(std::fabs(p.r)));
+    if (!at_start[i].inside) continue;
+    const double d = tukeyRho(p.r, limit) - tukeyRho(at_start[i].r, limit);
+    sum += d;
+    sum2 += d * d;
+    ++paired;
+  }
+  out.pixels = static_cast<int>(scratch.size());
+  out.residual_end = robustScale(scratch);
   if (out.residual_end >= 0.0) out.loss_end = tukeyLoss(scratch, sigma_start);
-  const LossChange change = lossChange(older, newer, taper, blocks, start, 1.0, bias_start, current,
-                                       gain, bias, sparse, sigma_start);
-  if (change.valid) {
-    out.loss_change = change.mean;
-    out.loss_change_sigma = change.sigma;
+  if (paired >= kSimilarityParameters * 10) {  // as robustScale
+    out.loss_change = sum / paired;
+    out.loss_change_sigma = std::sqrt(std::max(sum2 / paired - out.loss_change * out.loss_change, 0.0) / (paired - 1));
   }
   return out;
 }

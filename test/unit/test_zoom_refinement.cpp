@@ -351,21 +351,24 @@ TEST(ZoomRefinement, AShiftThatNothingFollowsLeavesTheFitAsItWas) {
   EXPECT_NEAR(with.similarity.rotation * kN / CV_PI, without.similarity.rotation * kN / CV_PI, 0.01);
 }
 
-TEST(ZoomRefinement, AWallBetweenTheLayersDoesNotTurnTheFit) {
-  // Ground moving 15 px along x (the followed layer), a raised top 40 % nearer moving 21 px, and
-  // between them across the lower part of the view a wall, whose rows move by every shift
-  // between the two with their height. A wall on one side of the motion moves along it by more
-  // the further out it lies, as a turn would move it: the fit over all pixels reads a turn; the
-  // wall's cells, which shifts between the layers fit better, are left out and the turn read is
-  // the ground's (none).
-  const double per_bin = logZoomPerBin();
-  const SeparableWindow window(kN, RegistrationConfig{}.taper_fraction);
-  const int stride = static_cast<int>(std::lround(kN / std::sqrt(3000.0)));
+// Ground moving 15 px along x (the followed layer) and, with `layers`, a raised top 40 % nearer
+// moving 21 px and between them across the lower part of the view a wall, whose rows move by
+// every shift between the two with their height; sensor noise of 5 grey levels, under which the
+// biweight weighs the wall's lower rows as much as the ground.
+struct WallScene {
+  cv::Mat1f older, newer;
+  double variance = 0.0;
+  cv::Point2d step, top_step;
+};
+
+WallScene wallScene(bool layers) {
+  WallScene scene;
+  scene.step = {15.0, 0.0};
+  scene.top_step = {21.0, 0.0};
   const cv::Mat1f& ground = test::sceneTexture(8);
   const cv::Mat1f& tops = test::sceneTexture(9);
   const cv::Mat1f& walls = test::sceneTexture(10);
   const cv::Point2d centre(ground.cols / 2.0, ground.rows / 2.0);
-  const cv::Point2d step(15.0, 0.0), top_step(21.0, 0.0);
   const int wall_first = 330, wall_last = 470;  // rows of the newer view the wall covers
   const int heights = 12;
   const auto shifted = [&](const cv::Mat1f& texture, const cv::Point2d& shift) {
@@ -373,42 +376,79 @@ TEST(ZoomRefinement, AWallBetweenTheLayersDoesNotTurnTheFit) {
     motion.shift = shift;
     return sim::renderView(texture, centre, motion, kN);
   };
-  cv::Mat1f older(kN, kN), newer(kN, kN);
-  const cv::Mat1f ground0 = shifted(ground, {}), ground1 = shifted(ground, step);
-  const cv::Mat1f tops0 = shifted(tops, {}), tops1 = shifted(tops, top_step);
-  std::vector<cv::Mat1f> walls0, walls1;
-  for (int h = 0; h < heights; ++h) {
-    const double f = (h + 0.5) / heights;
-    walls0.push_back(shifted(walls, {}));
-    walls1.push_back(shifted(walls, step + (top_step - step) * f));
-  }
-  for (int y = 0; y < kN; ++y) {
-    for (int x = 0; x < kN; ++x) {
-      const bool top = x < 200 && y < 200;
-      const bool wall = y >= wall_first && y <= wall_last;
-      const int h = std::min(heights - 1, (y - wall_first) * heights / (wall_last - wall_first + 1));
-      older(y, x) = top ? tops0(y, x) : wall ? walls0[h](y, x) : ground0(y, x);
-      newer(y, x) = top ? tops1(y, x) : wall ? walls1[h](y, x) : ground1(y, x);
+  scene.older = shifted(ground, {});
+  scene.newer = shifted(ground, scene.step);
+  if (layers) {
+    const cv::Mat1f tops0 = shifted(tops, {}), tops1 = shifted(tops, scene.top_step);
+    std::vector<cv::Mat1f> walls0, walls1;
+    for (int h = 0; h < heights; ++h) {
+      const double f = (h + 0.5) / heights;
+      walls0.push_back(shifted(walls, {}));
+      walls1.push_back(shifted(walls, scene.step + (scene.top_step - scene.step) * f));
+    }
+    for (int y = 0; y < kN; ++y) {
+      for (int x = 0; x < kN; ++x) {
+        const int h = std::min(heights - 1, (y - wall_first) * heights / (wall_last - wall_first + 1));
+        if (x < 200 && y < 200) {
+          scene.older(y, x) = tops0(y, x);
+          scene.newer(y, x) = tops1(y, x);
+        } else if (y >= wall_first && y <= wall_last) {
+          scene.older(y, x) = walls0[h](y, x);
+          scene.newer(y, x) = walls1[h](y, x);
+        }
+      }
     }
   }
-  // Sensor noise, under which the biweight weighs the wall's lower rows as much as the ground.
-  const double variance = (5.0 / 255.0) * (5.0 / 255.0);
+  scene.variance = (5.0 / 255.0) * (5.0 / 255.0);
   cv::RNG rng(12);
-  cv::Mat1f noise(older.size());
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, std::sqrt(variance));
-  older += noise;
-  rng.fill(noise, cv::RNG::NORMAL, 0.0, std::sqrt(variance));
-  newer += noise;
+  cv::Mat1f noise(scene.older.size());
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, std::sqrt(scene.variance));
+  scene.older += noise;
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, std::sqrt(scene.variance));
+  scene.newer += noise;
+  return scene;
+}
+
+TEST(ZoomRefinement, AWallBetweenTheLayersDoesNotTurnTheFit) {
+  // A wall on one side of the motion moves along it by more the further out it lies, as a turn
+  // would move it: the fit over all pixels reads a turn; the wall's cells, which shifts between
+  // the layers fit better, are left out and the turn read is the ground's (none).
+  const double per_bin = logZoomPerBin();
+  const SeparableWindow window(kN, RegistrationConfig{}.taper_fraction);
+  const int stride = static_cast<int>(std::lround(kN / std::sqrt(3000.0)));
+  const WallScene scene = wallScene(true);
   ImageSimilarity start;
-  start.translation = step;
-  const RefinementImage a = makeRefinementImage(older, variance), b = makeRefinementImage(newer, variance);
-  const SimilarityRefinement with = refineSimilarity(a, b, start, window.taper(), 4, stride, false, {top_step});
+  start.translation = scene.step;
+  const RefinementImage a = makeRefinementImage(scene.older, scene.variance);
+  const RefinementImage b = makeRefinementImage(scene.newer, scene.variance);
+  const SimilarityRefinement with = refineSimilarity(a, b, start, window.taper(), 4, stride, false, {scene.top_step});
   const SimilarityRefinement without = refineSimilarity(a, b, start, window.taper(), 4, stride);
   const double bins_with = with.similarity.rotation * kN / CV_PI, bins_without = without.similarity.rotation * kN / CV_PI;
   EXPECT_GT(with.dropped_cells, 10) << with.dropped_blocks;
   EXPECT_LT(std::fabs(bins_with), 0.02) << "without the layers' shifts " << bins_without;
   EXPECT_GT(std::fabs(bins_without), 3.0 * std::fabs(bins_with)) << bins_with;
   EXPECT_NEAR(with.similarity.log_zoom / per_bin, 0.0, 0.05);
+}
+
+TEST(ZoomRefinement, TheCellsLeftOutAreLeftOutOfTheScalesAndTheLossToo) {
+  // The residuals' scales and the loss that judges the fit are read on a sparser grid than the
+  // steps'; the wall's and the top's cells left out of the steps are left out there too, so the
+  // loss at the end is the ground's alone, as over a scene of ground only.
+  const SeparableWindow window(kN, RegistrationConfig{}.taper_fraction);
+  const int stride = static_cast<int>(std::lround(kN / std::sqrt(3000.0)));
+  const WallScene layered = wallScene(true), flat = wallScene(false);
+  ImageSimilarity start;
+  start.translation = layered.step;
+  const auto refine = [&](const WallScene& scene) {
+    const RefinementImage a = makeRefinementImage(scene.older, scene.variance);
+    const RefinementImage b = makeRefinementImage(scene.newer, scene.variance);
+    return refineSimilarity(a, b, start, window.taper(), 4, stride, false, {scene.top_step});
+  };
+  const SimilarityRefinement with_layers = refine(layered), ground_only = refine(flat);
+  ASSERT_GT(ground_only.loss_end, 0.0);
+  // What is left above the ground's is the cells the test keeps (at the wall's foot and the
+  // top's edges); the left-out cells read on the sparser grid would add as much again.
+  EXPECT_LT(with_layers.loss_end - ground_only.loss_end, 0.07) << with_layers.loss_end << " vs " << ground_only.loss_end;
 }
 
 TEST(ZoomRefinement, AWholePairsZoomMatchedOnTheEnergyVectorsLocksTowardTheWholeBin) {
