@@ -67,6 +67,17 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
     initial = measured;
     initial.translation = obs.translation;
     initial.translation_covariance = obs.translation_covariance;
+    // The registration's zoom is the highest peak's layer's (its refinement starts at that
+    // shift). A climb zooms each layer by the inverse of its depth, as the motion shifts it: where
+    // the highest peak is another layer of the motion, the followed layer's zoom is that one's
+    // scaled by the two peaks' ratio, both read in this pair. Taken as it is, a climb over roofs
+    // reads the roofs' larger zoom wherever their peak is the highest, and the altitude grows by
+    // it (the zoom's sigma is left as read: the ratio is known far better).
+    if (measured.shift() > 0.0 && alongMotion(measured.translation)) {
+      const double layer_ratio = cv::norm(obs.translation) / measured.shift();
+      obs.log_zoom.front().value *= layer_ratio;  // fromMotion's: the registration's zoom
+      initial.log_zoom *= layer_ratio;
+    }
     return;
   }
   // The followed layer is not in view. A correlation peak along the motion is another layer of

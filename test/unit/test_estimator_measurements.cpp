@@ -133,7 +133,7 @@ TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
 // PMT reading `stretch` of that length to a relative sigma `pmt_sigma` (stretch 0: no PMT).
 PairMotion observedAfter132(const RegistrationPrior& prior, double shift_sigma,
                             const PairRegistration& registration, double stretch, double pmt_sigma,
-                            PairObservations* out = nullptr) {
+                            PairObservations* out = nullptr, double log_zoom = 0.0) {
   detail::Reference ref;
   ref.translation = {132.0, 0.0};
   ref.shift = 132.0;
@@ -143,9 +143,12 @@ PairMotion observedAfter132(const RegistrationPrior& prior, double shift_sigma,
   pmt.value = stretch;
   pmt.sigma = pmt_sigma;
   PairMotion initial;
+  PairMotion measured = motionAlongX(registration.translation.x);
+  measured.log_zoom = log_zoom;
+  measured.log_zoom_sigma = 1e-3;
   const PairObservations obs =
-      detail::observe(registration, motionAlongX(registration.translation.x), pmt, MatchResult(), ref,
-                      EstimatorConfig(), kShiftPerBin, 1.0, 1.0, &prior, initial);
+      detail::observe(registration, measured, pmt, MatchResult(), ref, EstimatorConfig(), kShiftPerBin, 1.0, 1.0,
+                      &prior, initial);
   if (out) *out = obs;
   return initial;
 }
@@ -210,6 +213,36 @@ TEST(ObserveFollowedLayer, ATightPatternMatchTellsANeighbouringLayer) {
   EXPECT_EQ(obs.length_source, LengthSource::kEnergyPeak);
   EXPECT_NEAR(observedWithNeighbour(0.03, &obs).shift(), 125.9, 1e-9);
   EXPECT_EQ(obs.length_source, LengthSource::kWindowPeak);
+}
+
+// A climb over the same scene: the registration read the zoom of the highest peak's layer (the
+// ground, 108.9 px), the step follows the roofs' own peak (125.9 px) in the prediction's window.
+// Each layer zooms by the inverse of its depth, as it shifts: the step's zoom is the roofs', the
+// ground's scaled by the peaks' ratio, not the ground's as read.
+TEST(ObserveFollowedLayer, AWindowPeaksZoomIsItsLayersNotTheHighestPeaks) {
+  PairRegistration registration = withPeaks({{108.9, 1.0}, {132.0, 0.3}});
+  registration.translation = {108.9, 0.0};
+  registration.followed_translation = {125.9, 0.0};
+  registration.followed_confidence = 1.0;
+  PairObservations obs;
+  const double ground_zoom = 0.01;  // ln s: a climb of 1 % of the ground's depth
+  const PairMotion initial =
+      observedAfter132(predicted132(0.5, 40.0), 0.3, registration, 1.0, 0.03, &obs, ground_zoom);
+  ASSERT_EQ(obs.length_source, LengthSource::kWindowPeak);
+  ASSERT_FALSE(obs.log_zoom.empty());
+  EXPECT_NEAR(obs.log_zoom.front().value, ground_zoom * 125.9 / 108.9, 1e-12);
+  EXPECT_NEAR(initial.log_zoom, ground_zoom * 125.9 / 108.9, 1e-12);
+  // Where the highest peak is the followed layer's, its zoom stands as read.
+  PairRegistration roofs_highest = withPeaks({{132.0, 1.0}, {108.9, 0.3}});
+  roofs_highest.translation = {132.0, 0.0};
+  roofs_highest.followed_translation = roofs_highest.translation;
+  roofs_highest.followed_confidence = 1.0;
+  const double roof_zoom = ground_zoom * 132.0 / 108.9;
+  EXPECT_NEAR(
+      observedAfter132(predicted132(0.5, 40.0), 0.3, roofs_highest, 1.0, 0.03, &obs, roof_zoom).log_zoom,
+      roof_zoom, 1e-12);
+  EXPECT_EQ(obs.length_source, LengthSource::kPeak);
+  EXPECT_NEAR(obs.log_zoom.front().value, roof_zoom, 1e-12);
 }
 
 // The followed layer has left the view and no layer or stretch reads it: a peak on the motion
