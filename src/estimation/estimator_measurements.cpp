@@ -70,13 +70,16 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
     // The registration's zoom is the highest peak's layer's (its refinement starts at that
     // shift). A climb zooms each layer by the inverse of its depth, as the motion shifts it: where
     // the highest peak is another layer of the motion, the followed layer's zoom is that one's
-    // scaled by the two peaks' ratio, both read in this pair. Taken as it is, a climb over roofs
-    // reads the roofs' larger zoom wherever their peak is the highest, and the altitude grows by
-    // it (the zoom's sigma is left as read: the ratio is known far better).
+    // scaled by the two peaks' ratio, both read in this pair, and so is its error. Taken as it
+    // is, a climb over roofs reads the roofs' larger zoom wherever their peak is the highest, and
+    // the altitude grows by it.
     if (measured.shift() > 0.0 && alongMotion(measured.translation)) {
       const double layer_ratio = cv::norm(obs.translation) / measured.shift();
-      obs.log_zoom.front().value *= layer_ratio;  // fromMotion's: the registration's zoom
+      ScalarObservation& zoom = obs.log_zoom.front();  // fromMotion's: the registration's
+      zoom.value *= layer_ratio;
+      zoom.sigma *= layer_ratio;
       initial.log_zoom *= layer_ratio;
+      initial.log_zoom_sigma *= layer_ratio;
     }
     return;
   }

@@ -232,6 +232,8 @@ TEST(ObserveFollowedLayer, AWindowPeaksZoomIsItsLayersNotTheHighestPeaks) {
   ASSERT_FALSE(obs.log_zoom.empty());
   EXPECT_NEAR(obs.log_zoom.front().value, ground_zoom * 125.9 / 108.9, 1e-12);
   EXPECT_NEAR(initial.log_zoom, ground_zoom * 125.9 / 108.9, 1e-12);
+  EXPECT_NEAR(obs.log_zoom.front().sigma, 1e-3 * 125.9 / 108.9, 1e-12);  // its error scales alike
+  EXPECT_NEAR(initial.log_zoom_sigma, 1e-3 * 125.9 / 108.9, 1e-12);
   // Where the highest peak is the followed layer's, its zoom stands as read.
   PairRegistration roofs_highest = withPeaks({{132.0, 1.0}, {108.9, 0.3}});
   roofs_highest.translation = {132.0, 0.0};
