@@ -231,14 +231,34 @@ class BlockMask {
   std::vector<unsigned char> dropped_cells_;
 };
 
+// The grid the refinement's tests and steps read: every `stride`-th pixel of every `stride`-th
+// row where the taper is positive, row by row.
+struct GridPixel {
+  int x, y;
+  float taper;
+};
+
+std::vector<GridPixel> taperedGrid(const std::vector<float>& taper, int stride) {
+  const int n = static_cast<int>(taper.size());
+  std::vector<GridPixel> grid;
+  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
+    if (!(taper[y] > 0.0f)) continue;
+    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
+      const float w = taper[y] * taper[x];
+      if (w > 0.0f) grid.push_back({x, y, w});
+    }
+  }
+  return grid;
+}
+
 // The blocks where the start's shift explains the frames no worse than the shift of any other
 // depth layer in `other_layers` (at the start's rotation and zoom): over several depths the
 // refinement must measure the followed layer's motion, and where the texture is weak against the
 // noise, Tukey's biweight cannot tell a pixel of another layer from a noisy one, so those layers
 // pull the zoom towards their own.
-BlockMask followedLayerBlocks(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
+BlockMask followedLayerBlocks(const RefinementImage& older, const RefinementImage& newer, const std::vector<GridPixel>& grid,
                               const ImageSimilarity& start, const std::vector<cv::Point2d>& other_layers,
-                              double bias, int stride) {
+                              double bias) {
   const int n = newer.smooth.rows;
   BlockMask blocks(n);
   if (other_layers.empty()) return blocks;
@@ -255,24 +275,20 @@ BlockMask followedLayerBlocks(const RefinementImage& older, const RefinementImag
     int count = 0;
   };
   std::vector<Sums> sums(static_cast<std::size_t>(kLayerBlocks * kLayerBlocks) * others.size());
-  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
-    if (!(taper[y] > 0.0f)) continue;
-    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-      if (!(taper[x] > 0.0f)) continue;
-      // residualAt's residual at gain 1, without its symmetric gradient.
-      double a = 0.0, ax = 0.0, ay = 0.0;
-      if (!olderAt(older, newer, followed, x, y, a, ax, ay)) continue;
-      const double own = newer.smooth(y, x) - (a + bias);
-      const std::size_t block = static_cast<std::size_t>(blocks.index(x, y));
-      for (std::size_t i = 0; i < others.size(); ++i) {
-        if (!olderAt(older, newer, others[i], x, y, a, ax, ay)) continue;
-        const double other = newer.smooth(y, x) - (a + bias);
-        const double d = own * own - other * other;
-        Sums& s = sums[block * others.size() + i];
-        s.d += d;
-        s.d2 += d * d;
-        ++s.count;
-      }
+  for (const GridPixel& g : grid) {
+    // residualAt's residual at gain 1, without its symmetric gradient.
+    double a = 0.0, ax = 0.0, ay = 0.0;
+    if (!olderAt(older, newer, followed, g.x, g.y, a, ax, ay)) continue;
+    const double own = newer.smooth(g.y, g.x) - (a + bias);
+    const std::size_t block = static_cast<std::size_t>(blocks.index(g.x, g.y));
+    for (std::size_t i = 0; i < others.size(); ++i) {
+      if (!olderAt(older, newer, others[i], g.x, g.y, a, ax, ay)) continue;
+      const double other = newer.smooth(g.y, g.x) - (a + bias);
+      const double d = own * own - other * other;
+      Sums& s = sums[block * others.size() + i];
+      s.d += d;
+      s.d2 += d * d;
+      ++s.count;
     }
   }
   for (int block = 0; block < kLayerBlocks * kLayerBlocks; ++block) {
@@ -416,22 +432,12 @@ int dropOtherSurfaceCells(const RefinementImage& older, const RefinementImage& n
   return dropped;
 }
 
-// The pixels the refinement reads: every `stride`-th of every `stride`-th row where the taper is
-// positive, in a kept block and cell.
-struct GridPixel {
-  int x, y;
-  float taper;
-};
-
-std::vector<GridPixel> gridPixels(const std::vector<float>& taper, const BlockMask& blocks, int stride) {
-  const int n = static_cast<int>(taper.size());
+// The pixels the refinement reads: those of the grid in a kept block and cell.
+std::vector<GridPixel> keptPixels(const std::vector<GridPixel>& grid, const BlockMask& blocks) {
   std::vector<GridPixel> pixels;
-  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
-    if (!(taper[y] > 0.0f)) continue;
-    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-      const float w = taper[y] * taper[x];
-      if (w > 0.0f && blocks.kept(x, y)) pixels.push_back({x, y, w});
-    }
+  pixels.reserve(grid.size());
+  for (const GridPixel& g : grid) {
+    if (blocks.kept(g.x, g.y)) pixels.push_back(g);
   }
   return pixels;
 }
@@ -459,24 +465,19 @@ double gradientNoiseVariance(double older_variance, double newer_variance) {
   return 0.25 * (older_variance * factors.bilinear + newer_variance * factors.central);
 }
 
-// The exposure's offset between the frames at `motion`: the mean difference of the pixels both
-// see (every `stride`-th of every `stride`-th row; their differences are left in `residuals`);
+// The exposure's offset between the frames at `motion`: the mean difference of the grid's pixels
+// both see (their differences are left in `residuals`);
 // 0 when too few do. Left to the steps instead, an exposure change larger than the texture's
 // contrast sets the first step's robust scale, under which the biweight keeps every depth layer
 // and the steps fit their compromise.
-double exposureOffset(const RefinementImage& older, const RefinementImage& newer, const std::vector<float>& taper,
-                      const ImageSimilarity& motion, int stride, std::vector<float>& residuals) {
-  const int n = newer.smooth.rows;
-  const InverseMap map(motion, n);
+double exposureOffset(const RefinementImage& older, const RefinementImage& newer, const std::vector<GridPixel>& grid,
+                      const ImageSimilarity& motion, std::vector<float>& residuals) {
+  const InverseMap map(motion, newer.smooth.rows);
   residuals.clear();
-  for (int y = stride / 2 + 1; y < n - 1; y += stride) {
-    if (!(taper[y] > 0.0f)) continue;
-    for (int x = stride / 2 + 1; x < n - 1; x += stride) {
-      if (!(taper[x] > 0.0f)) continue;
-      // residualAt's difference at gain 1 and bias 0, without its symmetric gradient.
-      double a = 0.0, ax = 0.0, ay = 0.0;
-      if (olderAt(older, newer, map, x, y, a, ax, ay)) residuals.push_back(static_cast<float>(newer.smooth(y, x) - a));
-    }
+  for (const GridPixel& g : grid) {
+    // residualAt's difference at gain 1 and bias 0, without its symmetric gradient.
+    double a = 0.0, ax = 0.0, ay = 0.0;
+    if (olderAt(older, newer, map, g.x, g.y, a, ax, ay)) residuals.push_back(static_cast<float>(newer.smooth(g.y, g.x) - a));
   }
   if (residuals.size() < kSimilarityParameters * 10u) return 0.0;
   double sum = 0.0;
@@ -566,18 +567,19 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
   ImageSimilarity current = start;
   double gain = 1.0;
   std::vector<float> scratch;
-  // The exposure's offset on the steps' grid: on the sparser one its estimate is noisy enough to
-  // move the first step's robust weights on frames without any.
-  double bias = exposureOffset(older, newer, taper, start, stride, scratch);
+  const std::vector<GridPixel> grid = taperedGrid(taper, stride);
+  // The exposure's offset on the steps' own grid: on a sparser grid its estimate is noisy enough
+  // to move the first step's robust weights on frames without any.
+  double bias = exposureOffset(older, newer, grid, start, scratch);
   // The blocks are chosen at the start: after a step, which fits the layers' compromise, the other
   // layers' shifts fit the blocks less well than the start's did.
-  BlockMask blocks = followedLayerBlocks(older, newer, taper, start, other_layers, bias, stride);
+  BlockMask blocks = followedLayerBlocks(older, newer, grid, start, other_layers, bias);
   out.dropped_blocks = blocks.dropped();
   if (!other_layers.empty()) {
     out.dropped_cells = dropOtherSurfaceCells(older, newer, taper, start, triedShifts(start.translation, other_layers),
                                               bias, stride, blocks);
   }
-  const std::vector<GridPixel> pixels = gridPixels(taper, blocks, stride);
+  const std::vector<GridPixel> pixels = keptPixels(grid, blocks);
   // The residuals at the start, which set the first step's robust weights and scale the loss
   // that judges the fit, are the first step's residuals too.
   std::vector<PixelResidual> at_start;
@@ -632,8 +634,9 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       if (gradient_noise > 0.0) moments.add(w, px, py);
     }
     if (gradient_noise > 0.0) moments.subtractNoise(gradient_noise, parameters, normal);
-    // The next step's scale: this pass's residuals (before its step).
-    const double next = robustScale(scratch);
+    // The next step's scale: this pass's residuals (before its step); the first pass's are the
+    // start's, whose scale is known.
+    const double next = iteration == 0 ? sigma_start : robustScale(scratch);
     if (!(next > 0.0)) return out;
     sigma = next;
     for (int a = 0; a < kParameters; ++a) {
