@@ -47,6 +47,19 @@ PairRegistration registerViews(const Views& views, const RegistrationPrior* prio
   return registrar.registerPair(older, newer, RegistrationMethod::kEnergyVectors, nullptr, prior, CV_PI / 4.0);
 }
 
+// A prediction of no turn and no zoom (narrow windows) and of a translation within `radius` px.
+RegistrationPrior stillPriorWithShift(const cv::Point2d& translation, double radius) {
+  RegistrationPrior prior;
+  prior.rotation_sigma = 0.01;
+  prior.log_zoom_sigma = 0.005;
+  prior.rotation_window = 0.05;
+  prior.log_zoom_window = 0.03;
+  prior.translation = translation;
+  prior.translation_radius = radius;
+  prior.translation_sigma = 1.0;
+  return prior;
+}
+
 TEST(TranslationRivals, APeriodicTexturesReadingWithoutAPredictionIsNotConfident) {
   const double brick_px = 60.0;
   const cv::Size brick = sim::brickSize(brick_px);
@@ -83,14 +96,7 @@ TEST(TranslationRivals, AnAmbiguousPredictionGivesWayToABetterPeak) {
   const Views views = shiftedViews(sim::naturalTexture(1024, 3, 48.0), kShift);
   // A prediction a brick period off (as a track that followed an alias would make), whose window
   // leaves the motion out.
-  RegistrationPrior prior;
-  prior.rotation_sigma = 0.01;
-  prior.log_zoom_sigma = 0.005;
-  prior.rotation_window = 0.05;
-  prior.log_zoom_window = 0.03;
-  prior.translation = cv::Point2d(kShift.x + 60.0, kShift.y);
-  prior.translation_radius = 20.0;
-  prior.translation_sigma = 1.0;
+  RegistrationPrior prior = stillPriorWithShift(cv::Point2d(kShift.x + 60.0, kShift.y), 20.0);
   const PairRegistration trusted = registerViews(views, &prior);
   EXPECT_FALSE(trusted.translation_unrivalled);
   EXPECT_TRUE(trusted.translation_implausible) << "a trusted prediction rules the motion out";
@@ -128,14 +134,7 @@ TEST(TranslationRivals, TheEnergyVectorIsReadAlongTheTakenPeak) {
   const cv::Size brick = sim::brickSize(brick_px);
   const cv::Point motion(2 * brick.width + 3, 1);
   const Views views = shiftedViews(sim::brickTexture(1024, 5, brick_px), motion);
-  RegistrationPrior prior;
-  prior.rotation_sigma = 0.01;
-  prior.log_zoom_sigma = 0.005;
-  prior.rotation_window = 0.05;
-  prior.log_zoom_window = 0.03;
-  prior.translation = cv::Point2d(motion.x + 0.5, motion.y);
-  prior.translation_radius = 8.0;
-  prior.translation_sigma = 1.0;
+  const RegistrationPrior prior = stillPriorWithShift(cv::Point2d(motion.x + 0.5, motion.y), 8.0);
   const PairRegistration r = registerViews(views, &prior);
   ASSERT_NEAR(r.translation.x, motion.x, 0.5) << "the premise: the prediction takes the motion";
   ASSERT_NEAR(r.translation.y, motion.y, 0.5);
