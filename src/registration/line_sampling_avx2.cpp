@@ -63,6 +63,10 @@ void sampleLineLoop(const LineSamples& line) {
     const __m256 w = kTaper ? _mm256_mul_ps(_mm256_loadu_ps(taper + c), weight) : weight;
     _mm256_storeu_ps(out + c, _mm256_mul_ps(_mm256_sub_ps(value, offset), w));
   }
+  // The compiler leaves out its own vzeroupper before the tail call below: the callers' legacy
+  // SSE code (everything built for the portable target) would then run with the upper halves
+  // of the vector registers in use, and on some CPUs every such instruction waits on them.
+  _mm256_zeroupper();
   sampleOneByOne(line, c, count);
 }
 

@@ -6,6 +6,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#if defined(__x86_64__)
+#include <cpuid.h>
+#endif
 
 #include "oefmt/registration/fft.h"
 #include "oefmt/registration/phase_correlation.h"
@@ -205,6 +213,66 @@ TEST(SimdKernels, PolarRowsMatchThePortableLoopOnAPaddedSurface) {
                                      n / 2 + radius * std::sin(direction));
     EXPECT_NEAR(fast(at.y, at.x), expected, 1e-4) << at;
   }
+}
+
+#if defined(__x86_64__)
+// XINUSE (XGETBV with ECX = 1), bit 2: the upper halves of the vector registers are not in
+// their initial state. Where the CPU cannot tell, false.
+bool upperHalvesInUse() {
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  if (!__get_cpuid_count(0xD, 1, &eax, &ebx, &ecx, &edx) || (eax & 4u) == 0) return false;
+  unsigned low = 0, high = 0;
+  asm volatile("xgetbv" : "=a"(low), "=d"(high) : "c"(1));
+  return (low & 4u) != 0;
+}
+void dirtyUpperHalves() { asm volatile("vpcmpeqd %%ymm15, %%ymm15, %%ymm15" ::: "xmm15"); }
+void cleanUpperHalves() { asm volatile("vzeroupper" ::: "memory"); }
+#endif
+
+// Every AVX2 kernel returns with the upper halves of the vector registers clean (vzeroupper):
+// the portable code that follows uses legacy SSE instructions, and on some CPUs each of those
+// waits on dirty upper halves (the scalar refinement ran about twice as slow).
+TEST(SimdKernels, KernelsReturnWithTheUpperHalvesOfTheVectorRegistersClean) {
+#if defined(__x86_64__)
+  if (!detail::runsAvx2(SimdKernel::kAuto)) GTEST_SKIP() << "no AVX2 kernels on this CPU";
+  dirtyUpperHalves();
+  const bool seen_dirty = upperHalvesInUse();
+  cleanUpperHalves();
+  if (!seen_dirty || upperHalvesInUse()) GTEST_SKIP() << "the CPU does not report the vector registers' use";
+  RegistrationConfig config;
+  config.size = 68;  // tails after the eight-wide steps
+  config.fft_planning = FftPlanning::kEstimate;
+  const SpectralContext context(config);
+  const int n = config.size;
+  cv::Mat1f magnitude(n / 2 + 2, n), surface(n, n), row(1, 37), out;
+  cv::RNG(23).fill(magnitude, cv::RNG::UNIFORM, 0.0f, 10.0f);
+  cv::RNG(24).fill(surface, cv::RNG::UNIFORM, -1.0f, 1.0f);
+  cv::RNG(25).fill(row, cv::RNG::NORMAL, 0.0f, 1.0f);
+  const cv::Mat2f newer = randomSpectrum(n, n / 2 + 1, 5), older = randomSpectrum(n, n / 2 + 1, 6);
+  cv::Mat2f cross;
+  const std::vector<std::pair<std::string, std::function<void()>>> kernels = {
+      {"log-polar rays", [&] { context.logPolar(magnitude, out, SimdKernel::kAuto); }},
+      {"polar rows", [&] { context.polarRows(surface, -3, 7, out, SimdKernel::kAuto); }},
+      {"row statistics", [&] { detail::rowStats(row[0], row.cols, true); }},
+      {"magnitude", [&] { upperHalfMagnitude(newer, cv::Mat1f(n / 2 + 2, n, 1.0f), out, SimdKernel::kAuto); }},
+      {"cross power", [&] { normalisedCrossPower(newer, older, cross, false, SimdKernel::kAuto); }},
+      {"weighted cross power",
+       [&] { centredCrossPower(newer, older, cross, true, SimdKernel::kAuto, 4000.0f, 6000.0f); }},
+  };
+  for (const auto& kernel : kernels) {
+    for (const bool dirty_before : {false, true}) {
+      if (dirty_before) {
+        dirtyUpperHalves();
+      } else {
+        cleanUpperHalves();
+      }
+      kernel.second();
+      EXPECT_FALSE(upperHalvesInUse()) << kernel.first << (dirty_before ? ", called dirty" : ", called clean");
+    }
+  }
+#else
+  GTEST_SKIP() << "x86-64 only";
+#endif
 }
 
 // The unwraps refuse a source of the wrong size with a clear error instead of reading past it.
