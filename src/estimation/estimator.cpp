@@ -804,11 +804,10 @@ PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) 
   if (!have01 || !(length > 0.0)) return step;
   const double steady = steadyLength(est);
   const std::optional<double> vouched = layer_ratios.vouchedLength(layerShifts(est.registration12), steady);
-  if (!vouched || std::fabs(length - *vouched) <= config.tracking.layer_gate * *vouched) return step;
-  // The layers mend a step that broke away from the motion so far, and never move one that held
-  // to it: a periodic texture's aliases hold ratios of their own, and the lengths they vouch for
-  // jump.
-  if (!(std::fabs(*vouched - steady) < std::fabs(length - steady))) return step;
+  if (!vouched || !detail::vouchedLengthWins(length, est.length_source, *vouched, steady, config.tracking.layer_gate,
+                                             kLayerRatioTolerance)) {
+    return step;
+  }
   est.vouched_length = *vouched;
   est.length_source = LengthSource::kVouched;
   return atVouchedLength(step, *vouched);

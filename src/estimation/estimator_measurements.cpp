@@ -200,6 +200,18 @@ double lengthSpread(double length, const std::vector<double>& alternatives, doub
   return spread;
 }
 
+bool vouchedLengthWins(double length, LengthSource source, double vouched, double steady, double layer_gate,
+                       double tolerance) {
+  if (!(length > 0.0) || !(vouched > 0.0) || !(steady > 0.0)) return false;
+  const double step_off = std::fabs(length - steady), vouched_off = std::fabs(vouched - steady);
+  // A periodic texture's aliases hold ratios of their own, and the lengths they vouch for jump:
+  // never towards a length further from the prediction than the step.
+  if (!(vouched_off < step_off)) return false;
+  if (std::fabs(length - vouched) > layer_gate * vouched) return true;
+  const bool weak = source == LengthSource::kEnergyPeak || source == LengthSource::kLayerRatio;
+  return weak && vouched_off <= 2.0 * tolerance * steady && vouched_off + tolerance * steady < step_off;
+}
+
 PairMotion withAlongTrackSpread(const PairMotion& motion, double spread) {
   const double length = motion.shift();
   if (!(spread > 0.0) || !(length > 0.0)) return motion;

@@ -96,6 +96,19 @@ ShiftMatchOptions shiftOptions(const MatchingConfig& matching);
 /// non-positive or non-finite alternatives are ignored.
 double lengthSpread(double length, const std::vector<double>& alternatives, double layer_gate, double window);
 
+/// Whether a step of `length` [px], read off `source`, gives way to the `vouched` length (the
+/// ratios the layers in view held over the last steps, LayerRatioMemory). `steady` is the length
+/// the motion so far predicts; `tolerance` the ratios' own (relative). The layers mend a step that
+/// broke away from the motion so far (further than `layer_gate` from the vouched length) and never
+/// move one that held to it. Within the gate a weak reading (the followed layer taken as an energy
+/// peak near the steady length, or a layer ratio between the pairs) gives way too where the
+/// vouched length and the prediction, two independent readings, agree (within twice the
+/// tolerance) and the step lies clearly further from the prediction: on a periodic texture an
+/// alias of the followed layer stands within the gate, its peak low, wherever that layer has left
+/// the view.
+bool vouchedLengthWins(double length, LengthSource source, double vouched, double steady, double layer_gate,
+                       double tolerance);
+
 /// `motion` with `spread`^2 added to its translation covariance along its direction.
 PairMotion withAlongTrackSpread(const PairMotion& motion, double spread);
 

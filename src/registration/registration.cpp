@@ -33,6 +33,8 @@ constexpr double kRotationZoomPsrGood = 20.0;
 // Energy vectors).
 constexpr int kPolarBandHalfWidth = 16;
 constexpr int kEnergyRowBand = 12;
+// Radius columns either side of the chosen translation peak's that the polar peak is searched in.
+constexpr int kPolarPeakHalfCols = 2;
 
 // Half size of the window cleared around a rotation/zoom peak already tried [bins]: wider than
 // the log-polar peak, narrower than a quarter turn's distance.
@@ -540,14 +542,20 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
     const int centre_row = static_cast<int>(std::lround(result.direction * n / (2.0 * CV_PI)));
     polar_first_row_ = centre_row - band;
     context_->polarRows(surface_, polar_first_row_, 2 * band + 1, polar_);
-    const SurfacePeak polar_peak = findPeak(polar_, false);
+    // The energy vector is read along the chosen peak's own direction: the polar surface's
+    // highest value may be another one (a periodic texture's alias near the origin, which every
+    // direction row passes through).
+    const double radius_step = context_->polarRadiusStep();
+    const SurfacePeak polar_peak =
+        findPeakInWindow(polar_, cv::Point(static_cast<int>(std::lround(result.shift / radius_step)), band),
+                         band, kPolarPeakHalfCols, false);
     // Radius columns do not wrap; the rho ~ 0 column is suppressed (see energy_vector.cpp).
     EnergyVectorOptions options = energyVectorOptions(context_->config());
     options.cyclic_cols = false;
     options.suppress_low_cols = true;
     EnergyVector shift_vector = extractEnergyVector(polar_, polar_peak, options);
     result.direction_sigma = shift_vector.row_sigma * 2.0 * CV_PI / n;
-    result.shift_sigma = shift_vector.col_sigma * context_->polarRadiusStep();
+    result.shift_sigma = shift_vector.col_sigma * radius_step;
     result.translation_energy = std::move(shift_vector.values);
   } else {
     const cv::Point2d widths = peakWidths(surface_, peak, true);

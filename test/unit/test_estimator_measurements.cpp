@@ -379,5 +379,41 @@ TEST(RateDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
   EXPECT_TRUE(exact.outlier(4.1 * floor));
 }
 
+// A circle over brick on every layer: the high tops (132.4 px a frame) left the view, an alias
+// of theirs 4.7 % shorter stands within the layer gate, and the ratios the layers held vouch for
+// 132.4 from the lower tops' peak.
+constexpr double kSteady = 132.1, kVouched = 132.4, kAlias = 125.9;
+constexpr double kGate = 0.05, kRatioTolerance = 0.01;
+
+TEST(VouchedLength, AWeakReadingWithinTheGateGivesWayWhereTheLayersAndTheMotionAgree) {
+  EXPECT_TRUE(detail::vouchedLengthWins(kAlias, LengthSource::kEnergyPeak, kVouched, kSteady, kGate, kRatioTolerance));
+  EXPECT_TRUE(detail::vouchedLengthWins(kAlias, LengthSource::kLayerRatio, kVouched, kSteady, kGate, kRatioTolerance));
+}
+
+TEST(VouchedLength, TheHighestPeakOrTheFollowedLayersOwnWithinTheGateStands) {
+  // The pair's own correlation peak (or the one where the prediction pointed) is a reading of its
+  // own: within the gate, the vehicle may have changed its speed.
+  EXPECT_FALSE(detail::vouchedLengthWins(kAlias, LengthSource::kPeak, kVouched, kSteady, kGate, kRatioTolerance));
+  EXPECT_FALSE(detail::vouchedLengthWins(kAlias, LengthSource::kWindowPeak, kVouched, kSteady, kGate, kRatioTolerance));
+}
+
+TEST(VouchedLength, WithoutTheMotionsAgreementAWeakReadingWithinTheGateStands) {
+  // The vouched length 3 % off the prediction: the two do not agree, nothing outweighs the step.
+  EXPECT_FALSE(detail::vouchedLengthWins(kAlias, LengthSource::kEnergyPeak, kSteady * 0.97, kSteady, kGate,
+                                         kRatioTolerance));
+  // A step within the ratios' noise of the prediction is not moved.
+  EXPECT_FALSE(detail::vouchedLengthWins(kSteady * 0.995, LengthSource::kEnergyPeak, kVouched, kSteady, kGate,
+                                         kRatioTolerance));
+}
+
+TEST(VouchedLength, AStepThatBrokeAwayGivesWayButNeverTowardsAFurtherLength) {
+  // Beyond the gate from the vouched length, whatever its source, towards the prediction.
+  EXPECT_TRUE(detail::vouchedLengthWins(kSteady * 0.9, LengthSource::kPeak, kVouched, kSteady, kGate, kRatioTolerance));
+  // A vouched length further from the prediction than the step (an alias's ratios) never wins.
+  EXPECT_FALSE(detail::vouchedLengthWins(kSteady * 0.9, LengthSource::kEnergyPeak, kSteady * 0.8, kSteady, kGate,
+                                         kRatioTolerance));
+  EXPECT_FALSE(detail::vouchedLengthWins(kSteady, LengthSource::kEnergyPeak, 0.0, kSteady, kGate, kRatioTolerance));
+}
+
 }  // namespace
 }  // namespace oefmt

@@ -6,8 +6,10 @@
 // a clearly better peak elsewhere wins over the prediction.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -121,6 +123,41 @@ TEST(TranslationRivals, AnAmbiguousPredictionGivesWayToABetterPeak) {
   EXPECT_FALSE(still_doubted.translation_unrivalled);
   EXPECT_NEAR(still_doubted.translation.x, half_period.x, 0.5) << "the prediction decides";
   EXPECT_NEAR(still_doubted.translation.y, half_period.y, 0.5);
+}
+
+TEST(TranslationRivals, TheEnergyVectorIsReadAlongTheTakenPeak) {
+  // Two bricks along plus a few pixels: one alias lies next to zero shift, where every direction
+  // row of the polar surface passes and which is the highest value of all of them, while the
+  // prediction takes the motion far out. The energy vector (the layers along the motion, which
+  // the estimator's layer tests read) must be read along the taken peak's direction.
+  const double brick_px = 60.0;
+  const cv::Size brick = sim::brickSize(brick_px);
+  const cv::Point motion(2 * brick.width + 3, 1);
+  const Views views = shiftedViews(sim::brickTexture(1024, 5, brick_px), motion);
+  RegistrationPrior prior;
+  prior.rotation_sigma = 0.01;
+  prior.log_zoom_sigma = 0.005;
+  prior.rotation_window = 0.05;
+  prior.log_zoom_window = 0.03;
+  prior.translation = cv::Point2d(motion.x + 0.5, motion.y);
+  prior.translation_radius = 8.0;
+  prior.translation_sigma = 1.0;
+  const PairRegistration r = registerViews(views, &prior);
+  ASSERT_NEAR(r.translation.x, motion.x, 0.5) << "the premise: the prediction takes the motion";
+  ASSERT_NEAR(r.translation.y, motion.y, 0.5);
+  const std::vector<float>& energy = r.translation_energy;
+  ASSERT_FALSE(energy.empty());
+  const float top = energy[static_cast<std::size_t>(test::argmax(energy))];
+  const double bin = cv::norm(motion) / test::sharedContext(kN)->polarRadiusStep();
+  float at_motion = 0.0f;  // the vector's highest local maximum within two bins of the motion
+  for (int j = static_cast<int>(bin) - 2; j <= static_cast<int>(bin) + 3; ++j) {
+    const std::size_t k = static_cast<std::size_t>(j);
+    if (energy[k] >= energy[k - 1] && energy[k] >= energy[k + 1]) at_motion = std::max(at_motion, energy[k]);
+  }
+  // The alias next to zero shift stays the vector's highest value (every row passes it); read
+  // along another row, the motion's peak would be missing altogether (about 1e-8 of it).
+  std::printf("[ rivals ] the motion's peak in the energy vector: %.2g of its highest value\n", at_motion / top);
+  EXPECT_GT(at_motion, 1e-3f * top) << "the taken peak stands in its own vector";
 }
 
 TEST(TranslationRivals, ARivalAsHighMakesTheStepCovarianceCoverBothReadings) {
