@@ -610,7 +610,8 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
       const GridPixel& g = pixels[i];
       const PixelResidual p = iteration == 0 ? at_start[i] : residualAt(older, newer, map, gain, bias, g.x, g.y);
       if (!p.inside) continue;
-      scratch.push_back(static_cast<float>(std::fabs(p.r)));
+      // The first pass's scale is the start's, already known.
+      if (iteration > 0) scratch.push_back(static_cast<float>(std::fabs(p.r)));
       const double u = p.r / limit;
       if (!(u * u < 1.0)) continue;
       const double w = g.taper * (1.0 - u * u) * (1.0 - u * u);
