@@ -689,7 +689,8 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   PairMotion initial12;
   const PairObservations obs12 =
       detail::observe(reg12, est.measured12, est.pmt12, est.pms12, ref, config, shift_per_bin,
-                      log_zoom_per_bin, double(gap12) / gap01, prior12 ? &*prior12 : nullptr, initial12);
+                      log_zoom_per_bin, double(gap12) / gap01, prior12 ? &*prior12 : nullptr, initial12,
+                      /*skipped_frames=*/gap12 > 1);
   est.translation_use12 = obs12.translation_use;
   est.length_source = obs12.length_source;
   est.measured12 = initial12;

@@ -26,7 +26,7 @@ constexpr double kPmtGateSigmas = 3.0;
 void observeFollowedLayer(const PairRegistration& registration, const PairMotion& measured,
                           const MatchResult& pmt, const Reference& ref, const EstimatorConfig& config,
                           double shift_per_bin, double intervals, const RegistrationPrior& prior,
-                          PairObservations& obs, PairMotion& initial) {
+                          bool skipped_frames, PairObservations& obs, PairMotion& initial) {
   const cv::Point2d predicted = prior.translation;
   const double length = cv::norm(predicted);
   const double gate =
@@ -97,8 +97,8 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
       std::fabs(pmt_length - length) <= prior.translation_radius;
   if (layered.translation == measured.translation && !pmt_says_other_layer) {
     // No layer tells the followed one's length: a peak the vehicle can reach is the motion's
-    // change (its layer is followed from here).
-    if (on_direction && cv::norm(measured.translation - predicted) <= prior.translation_radius) {
+    // change (its layer is followed from here), read off a pair over one frame interval only.
+    if (on_direction && !skipped_frames && cv::norm(measured.translation - predicted) <= prior.translation_radius) {
       obs.length_source = LengthSource::kMotionChange;
       return;
     }
@@ -314,7 +314,7 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
                          const MatchResult& pmt, const MatchResult& pms, const Reference& ref,
                          const EstimatorConfig& config, double shift_per_bin,
                          double log_zoom_per_bin, double intervals, const RegistrationPrior* prior,
-                         PairMotion& initial) {
+                         PairMotion& initial, bool skipped_frames) {
   PairObservations obs = PairObservations::fromMotion(measured);
   initial = measured;
   const bool predicted_translation = prior != nullptr && prior->translation_radius > 0.0;
@@ -329,8 +329,8 @@ PairObservations observe(const PairRegistration& registration, const PairMotion&
                             std::hypot(pms.sigma * log_zoom_per_bin, ref.raw_log_zoom_sigma)});
   }
   if (predicted_translation) {
-    observeFollowedLayer(registration, measured, pmt, ref, config, shift_per_bin, intervals, *prior, obs,
-                         initial);
+    observeFollowedLayer(registration, measured, pmt, ref, config, shift_per_bin, intervals, *prior,
+                         skipped_frames, obs, initial);
     return obs;
   }
   if (!pmt.valid) return obs;

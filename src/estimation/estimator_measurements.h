@@ -141,12 +141,16 @@ struct Reference {
 /// layer seen in both pairs) give its length and the correlation peak its direction if that
 /// lies on the predicted one (another layer of the same motion; otherwise nothing of it: a
 /// repetitive texture's alias); where no layer tells, a correlation peak within the
-/// acceleration window stands (the motion changed), else the prediction's length.
+/// acceleration window stands (the motion changed), else the prediction's length. Not over
+/// `skipped_frames` (the pair spans frames that were not registered): there the prediction
+/// reaches further, its acceleration window grew with the square of the time, and a peak inside
+/// it says less of a change of speed than a pair over one interval does. The prediction's length
+/// stands and a real change shows at the next pair.
 PairObservations observe(const PairRegistration& registration, const PairMotion& measured,
                          const MatchResult& pmt, const MatchResult& pms, const Reference& reference,
                          const EstimatorConfig& config, double shift_per_bin,
                          double log_zoom_per_bin, double intervals, const RegistrationPrior* prior,
-                         PairMotion& initial);
+                         PairMotion& initial, bool skipped_frames = false);
 
 /// The step of pair 1-2 that keeps following one depth layer. `candidate` is the loop's step
 /// (without a loop, the gated measurement). When its length is off steady speed (pair 0-1's

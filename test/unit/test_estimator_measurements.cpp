@@ -133,7 +133,8 @@ TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
 // PMT reading `stretch` of that length to a relative sigma `pmt_sigma` (stretch 0: no PMT).
 PairMotion observedAfter132(const RegistrationPrior& prior, double shift_sigma,
                             const PairRegistration& registration, double stretch, double pmt_sigma,
-                            PairObservations* out = nullptr, double log_zoom = 0.0) {
+                            PairObservations* out = nullptr, double log_zoom = 0.0,
+                            bool skipped_frames = false) {
   detail::Reference ref;
   ref.translation = {132.0, 0.0};
   ref.shift = 132.0;
@@ -148,7 +149,7 @@ PairMotion observedAfter132(const RegistrationPrior& prior, double shift_sigma,
   measured.log_zoom_sigma = 1e-3;
   const PairObservations obs =
       detail::observe(registration, measured, pmt, MatchResult(), ref, EstimatorConfig(), kShiftPerBin, 1.0, 1.0,
-                      &prior, initial);
+                      &prior, initial, skipped_frames);
   if (out) *out = obs;
   return initial;
 }
@@ -259,6 +260,24 @@ TEST(ObserveFollowedLayer, SaysWhetherTheSpeedChangedOrThePredictionStands) {
   EXPECT_NEAR(observedAfter132(predicted132(0.5, 10.0), 0.3, registration, 0.0, 0.0, &obs).shift(), 132.0, 1e-9);
   EXPECT_EQ(obs.length_source, LengthSource::kPrediction);
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
+}
+
+// The same peak over a pair that spans a frame that failed: the prediction reaches twice as far
+// and its acceleration window four times as wide, so a peak inside it is no reading of a change
+// of speed (an alias at 56 % of the predicted two-interval length passed as one). The
+// prediction's length stands, the peak's direction is kept, and the next pair over one interval
+// reads the change if there was one.
+TEST(ObserveFollowedLayer, NoChangeOfSpeedIsReadOverSkippedFrames) {
+  PairRegistration registration = withPeaks({{150.0, 1.0}});
+  registration.translation = {150.0, 0.0};
+  PairObservations obs;
+  const PairMotion over_skipped =
+      observedAfter132(predicted132(0.5, 30.0), 0.3, registration, 0.0, 0.0, &obs, 0.0, /*skipped_frames=*/true);
+  EXPECT_NEAR(over_skipped.shift(), 132.0, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kPrediction);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
+  EXPECT_NEAR(observedAfter132(predicted132(0.5, 30.0), 0.3, registration, 0.0, 0.0, &obs).shift(), 150.0, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kMotionChange);
 }
 
 // A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose
