@@ -32,6 +32,15 @@ cv::Mat2f randomSpectrum(int rows, int cols, int seed) {
   return spectrum;
 }
 
+// The configuration of an N = `size` context whose FFT plans are estimated, not measured: the
+// kernels under test do not depend on them.
+RegistrationConfig estimatedConfig(int size) {
+  RegistrationConfig config;
+  config.size = size;
+  config.fft_planning = FftPlanning::kEstimate;
+  return config;
+}
+
 TEST(SimdKernels, CrossPowerMatchesThePortableLoop) {
   // 45 complex columns (the real FFT's N/2 + 1 at N = 88): eight-wide steps, a four-wide one
   // and a tail of one.
@@ -170,11 +179,8 @@ double bilinear(const cv::Mat1f& image, double x, double y) {
 }
 
 TEST(SimdKernels, LogPolarRaysMatchThePortableLoopAndBilinearSampling) {
-  RegistrationConfig config;
-  config.size = 68;  // 68 columns: a tail of four after eight-wide steps
-  config.fft_planning = FftPlanning::kEstimate;
-  const SpectralContext context(config);
-  const int n = config.size;
+  const SpectralContext context(estimatedConfig(68));  // 68 columns: a tail of four after eight-wide steps
+  const int n = context.size();
   cv::Mat1f magnitude(n / 2 + 2, n);
   cv::RNG(21).fill(magnitude, cv::RNG::UNIFORM, 0.0f, 10.0f);  // seeded: not the shared RNG
   cv::Mat1f fast, portable;
@@ -192,11 +198,8 @@ TEST(SimdKernels, LogPolarRaysMatchThePortableLoopAndBilinearSampling) {
 }
 
 TEST(SimdKernels, PolarRowsMatchThePortableLoopOnAPaddedSurface) {
-  RegistrationConfig config;
-  config.size = 68;
-  config.fft_planning = FftPlanning::kEstimate;
-  const SpectralContext context(config);
-  const int n = config.size;
+  const SpectralContext context(estimatedConfig(68));
+  const int n = context.size();
   // The registration unwraps a view of an in-place FFT buffer (rows padded).
   cv::Mat2f buffer;
   cv::Mat1f surface = context.fft().inPlaceInput(buffer);
@@ -239,11 +242,8 @@ TEST(SimdKernels, KernelsReturnWithTheUpperHalvesOfTheVectorRegistersClean) {
   const bool seen_dirty = upperHalvesInUse();
   cleanUpperHalves();
   if (!seen_dirty || upperHalvesInUse()) GTEST_SKIP() << "the CPU does not report the vector registers' use";
-  RegistrationConfig config;
-  config.size = 68;  // tails after the eight-wide steps
-  config.fft_planning = FftPlanning::kEstimate;
-  const SpectralContext context(config);
-  const int n = config.size;
+  const SpectralContext context(estimatedConfig(68));  // tails after the eight-wide steps
+  const int n = context.size();
   cv::Mat1f magnitude(n / 2 + 2, n), surface(n, n), row(1, 37), out;
   cv::RNG(23).fill(magnitude, cv::RNG::UNIFORM, 0.0f, 10.0f);
   cv::RNG(24).fill(surface, cv::RNG::UNIFORM, -1.0f, 1.0f);
@@ -277,10 +277,7 @@ TEST(SimdKernels, KernelsReturnWithTheUpperHalvesOfTheVectorRegistersClean) {
 
 // The unwraps refuse a source of the wrong size with a clear error instead of reading past it.
 TEST(SimdKernels, UnwrapsRefuseSourcesOfTheWrongSize) {
-  RegistrationConfig config;
-  config.size = 64;
-  config.fft_planning = FftPlanning::kEstimate;
-  const SpectralContext context(config);
+  const SpectralContext context(estimatedConfig(64));
   cv::Mat1f out;
   for (const SimdKernel kernel : {SimdKernel::kAuto, SimdKernel::kPortable}) {
     EXPECT_THROW(context.logPolar(cv::Mat1f(64, 64, 1.0f), out, kernel), InputError);  // not N/2 + 2 rows

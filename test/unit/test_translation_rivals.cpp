@@ -134,14 +134,7 @@ TEST(TranslationRivals, TheEnergyVectorIsReadAlongTheTakenPeak) {
   const cv::Size brick = sim::brickSize(brick_px);
   const cv::Point motion(2 * brick.width + 3, 1);
   const Views views = shiftedViews(sim::brickTexture(1024, 5, brick_px), motion);
-  RegistrationPrior prior;
-  prior.rotation_sigma = 0.01;
-  prior.log_zoom_sigma = 0.005;
-  prior.rotation_window = 0.05;
-  prior.log_zoom_window = 0.03;
-  prior.translation = cv::Point2d(motion.x + 0.5, motion.y);
-  prior.translation_radius = 8.0;
-  prior.translation_sigma = 1.0;
+  const RegistrationPrior prior = stillPriorWithShift(cv::Point2d(motion.x + 0.5, motion.y), 8.0);
   const PairRegistration r = registerViews(views, &prior);
   ASSERT_NEAR(r.translation.x, motion.x, 0.5) << "the premise: the prediction takes the motion";
   ASSERT_NEAR(r.translation.y, motion.y, 0.5);
