@@ -229,7 +229,11 @@ SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int hal
   half_rows = std::clamp(half_rows, 0, (surface.rows - 1) / 2);
   half_cols = std::clamp(half_cols, 0, (surface.cols - 1) / 2);
   const bool weighted = sigma.x > 0.0 && sigma.y > 0.0;
-  cv::Point best(wrap(centre.x, surface.cols), wrap(centre.y, surface.rows));
+  // A clipped window reports its empty result inside the surface: a centre beyond the last
+  // column (a shift past a polar unwrap's reach) stands at the last column, not wrapped onto a
+  // column of another radius.
+  cv::Point best(cyclic_cols ? wrap(centre.x, surface.cols) : std::clamp(centre.x, 0, surface.cols - 1),
+                 wrap(centre.y, surface.rows));
   double best_score = -std::numeric_limits<double>::infinity();
   // The window's columns as at most two runs of the row (a cyclic window may wrap around).
   int runs[2][2];

@@ -102,6 +102,28 @@ TEST(Registration, FlightSizedShiftsLeaveRotationAndZoomAtZero) {
   EXPECT_NEAR(log_zoom_sum / kDirections, 0.0, 1.5e-4);
 }
 
+TEST(Registration, AShiftBeyondThePolarUnwrapsReachKeepsTheEnergyVectorOnItsDirection) {
+  // polar_radius_fraction 0.25 unwraps radii up to 128 px; the shift is 150 px.
+  RegistrationConfig config;
+  config.size = kN;
+  config.polar_radius_fraction = 0.25;
+  config.fft_planning = FftPlanning::kEstimate;  // a context of its own: no planning wait
+  Registrar registrar(std::make_shared<const SpectralContext>(config));
+  const double direction = rad(35.0);
+  sim::ViewMotion motion;
+  motion.shift = {150.0 * std::cos(direction), 150.0 * std::sin(direction)};
+  const auto pair = test::warpedPair(motion);
+  const PairRegistration r =
+      registrar.registerPair(registrar.analyse(pair.older), registrar.analyse(pair.newer));
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_NEAR(r.translation.x, motion.shift.x, 0.3);
+  EXPECT_NEAR(r.translation.y, motion.shift.y, 0.3);
+  ASSERT_EQ(static_cast<int>(r.translation_energy.size()), kN);
+  EXPECT_TRUE(std::isfinite(r.direction_sigma));
+  EXPECT_TRUE(std::isfinite(r.shift_sigma));
+  EXPECT_NEAR(r.direction, direction, 0.02);
+}
+
 class PureRotation : public ::testing::TestWithParam<double> {};
 
 TEST_P(PureRotation, AngleWithinFiveHundredthsOfADegree) {

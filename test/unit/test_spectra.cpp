@@ -135,6 +135,23 @@ TEST(PhaseCorrelation, OnePassPeakFindsNegativePeaksAndTheFirstOfTies) {
   EXPECT_EQ(peak.col, 3);
 }
 
+TEST(PhaseCorrelation, AWindowPastTheLastUnwrappedColumnReportsNoPeakAtThatColumn) {
+  // A polar unwrap's columns do not wrap: a window centred beyond them (a shift longer than the
+  // unwrap reaches) holds nothing, and its empty result must not land on a column of another
+  // radius.
+  cv::Mat1f surface = cv::Mat1f::zeros(9, 64);
+  surface(4, 36) = 1.0f;  // at the column a centre of 100 would wrap onto
+  const SurfacePeak beyond = findPeakInWindow(surface, cv::Point(100, 4), 2, 2, false);
+  EXPECT_EQ(beyond.value, 0.0f);
+  EXPECT_EQ(beyond.row, 4);
+  EXPECT_EQ(beyond.col, 63);
+  const SurfacePeak before = findPeakInWindow(surface, cv::Point(-7, 4), 2, 2, false);
+  EXPECT_EQ(before.value, 0.0f);
+  EXPECT_EQ(before.col, 0);
+  // Cyclic columns still wrap.
+  EXPECT_FLOAT_EQ(findPeakInWindow(surface, cv::Point(100, 4), 2, 2, true).value, 1.0f);
+}
+
 // A sinc peak widened by a Gaussian blur of `sigma` bins (as resampling widens the log-polar
 // correlation peak), centred at (row, col) + offset on both axes.
 cv::Mat1f widenedPeakSurface(int row, int col, double offset, double sigma) {

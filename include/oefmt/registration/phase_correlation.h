@@ -78,7 +78,8 @@ SurfacePeak findPeak(const cv::Mat1f& surface, bool cyclic_cols, SurfaceStats* s
 /// weighted by a Gaussian of those widths around the centre decides: of two peaks in the
 /// window, the one the prediction expects unless the other is much higher (only local maxima
 /// compete then). Positions within one cell of `exclude`, and values below `min_value`, are
-/// skipped (a peak already taken; the noise). When nothing qualifies, the result has value 0.
+/// skipped (a peak already taken; the noise). When nothing qualifies, the result has value 0,
+/// at the centre (a clipped centre beyond the columns stands at the nearest column).
 SurfacePeak findPeakInWindow(const cv::Mat1f& surface, cv::Point centre, int half_rows,
                              int half_cols, bool cyclic_cols, PeakShape shape = PeakShape::kDirichlet,
                              cv::Point2d sigma = {0.0, 0.0}, cv::Point exclude = {-10, -10},
