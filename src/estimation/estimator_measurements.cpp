@@ -73,14 +73,22 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
     // scaled by the two peaks' ratio, both read in this pair, and so is its error. Taken as it
     // is, a climb over roofs reads the roofs' larger zoom wherever their peak is the highest, and
     // the altitude grows by it.
-    if (measured.shift() > 0.0 && alongMotion(measured.translation)) {
-      const double layer_ratio = cv::norm(obs.translation) / measured.shift();
-      ScalarObservation& zoom = obs.log_zoom.front();  // fromMotion's: the registration's
+    ScalarObservation& zoom = obs.log_zoom.front();  // fromMotion's: the registration's
+    const double layer_ratio = measured.shift() > 0.0 ? cv::norm(obs.translation) / measured.shift() : 0.0;
+    if (alongMotion(measured.translation) && layer_ratio >= 1.0 / kMaxDepthLayerRatio &&
+        layer_ratio <= kMaxDepthLayerRatio) {
       zoom.value *= layer_ratio;
       zoom.sigma *= layer_ratio;
-      initial.log_zoom *= layer_ratio;
-      initial.log_zoom_sigma *= layer_ratio;
+    } else if (measured.shift() > 0.0) {
+      // The highest peak is no layer of the motion (an alias off its direction, or on it further
+      // than a layer can be), and the zoom refined at its shift says nothing of the followed
+      // layer's: the prediction's zoom stands, with both sigmas. Scaled by such a ratio, an
+      // alias's small zoom error became a step of the altitude.
+      zoom.value = prior.log_zoom;
+      zoom.sigma = std::hypot(zoom.sigma, prior.log_zoom_sigma);
     }
+    initial.log_zoom = zoom.value;
+    initial.log_zoom_sigma = zoom.sigma;
     return;
   }
   // The followed layer is not in view. A correlation peak along the motion is another layer of

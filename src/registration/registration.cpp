@@ -638,7 +638,8 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
     const cv::Point2d along = predicted * (1.0 / length);
     const double projection = highest.x * along.x + highest.y * along.y;
     const double across = std::fabs(highest.y * along.x - highest.x * along.y);
-    plausible = across <= radius && projection >= 0.5 * length && projection <= 2.0 * length;
+    plausible = across <= radius && projection >= length / kMaxDepthLayerRatio &&
+                projection <= kMaxDepthLayerRatio * length;
   }
   if (plausible && global >= windowed) return global;
   if (windowed > 0.0) {
@@ -680,7 +681,10 @@ void Registrar::findRival(const SurfacePeak& taken, float floor, PairRegistratio
       if (length > 0.0) {
         const double projection = shift.x * along.x + shift.y * along.y;
         const double across = std::fabs(shift.y * along.x - shift.x * along.y);
-        if (across <= kNeighbourhood && projection >= 0.5 * length && projection <= 2.0 * length) continue;
+        if (across <= kNeighbourhood && projection >= length / kMaxDepthLayerRatio &&
+            projection <= kMaxDepthLayerRatio * length) {
+          continue;
+        }
       }
       const double ratio = v / context_->window().overlapShare(shift) / taken_height;
       if (ratio > result.rival_ratio) {

@@ -248,6 +248,42 @@ TEST(ObserveFollowedLayer, AWindowPeaksZoomIsItsLayersNotTheHighestPeaks) {
   EXPECT_NEAR(obs.log_zoom.front().value, roof_zoom, 1e-12);
 }
 
+// A periodic texture's alias is the highest peak, on the motion's direction but 2.2 times as far
+// as the followed layer (no layer of the motion moves so much further): its refined zoom tells
+// nothing of the followed layer's. Scaled by that ratio, its small error would have been a step
+// of the altitude twice as large; the prediction's zoom stands, with both sigmas. Off the
+// direction alike.
+TEST(ObserveFollowedLayer, AnAliasesZoomGivesWayToThePrediction) {
+  RegistrationPrior prior = predicted132(0.5, 40.0);
+  prior.log_zoom = 1e-4;
+  prior.log_zoom_sigma = 2e-3;
+  const double alias_zoom = 0.0094;
+  for (const cv::Point2d alias : {cv::Point2d(290.0, 0.0), cv::Point2d(60.0, 90.0)}) {
+    PairRegistration registration = withPeaks({{132.0, 1.0}});
+    registration.translation = alias;
+    registration.followed_translation = {131.0, 0.0};
+    registration.followed_confidence = 1.0;
+    PairObservations obs;
+    detail::Reference ref;
+    ref.translation = {132.0, 0.0};
+    ref.shift = 132.0;
+    ref.shift_sigma = 0.3;
+    PairMotion measured = motionAlongX(1.0);
+    measured.translation = alias;
+    measured.log_zoom = alias_zoom;
+    measured.log_zoom_sigma = 1e-3;
+    PairMotion initial;
+    obs = detail::observe(registration, measured, MatchResult(), MatchResult(), ref, EstimatorConfig(),
+                          kShiftPerBin, 1.0, 1.0, &prior, initial, false);
+    ASSERT_EQ(obs.length_source, LengthSource::kWindowPeak) << alias;
+    ASSERT_FALSE(obs.log_zoom.empty());
+    EXPECT_DOUBLE_EQ(obs.log_zoom.front().value, prior.log_zoom) << alias;
+    EXPECT_DOUBLE_EQ(obs.log_zoom.front().sigma, std::hypot(1e-3, prior.log_zoom_sigma)) << alias;
+    EXPECT_DOUBLE_EQ(initial.log_zoom, prior.log_zoom) << alias;
+    EXPECT_DOUBLE_EQ(initial.log_zoom_sigma, obs.log_zoom.front().sigma) << alias;
+  }
+}
+
 // The followed layer has left the view and no layer or stretch reads it: a peak on the motion
 // that the vehicle could reach is taken as its change of speed, one it could not is not taken
 // and the prediction's length stands. The diagnostics say which.

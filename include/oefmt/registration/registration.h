@@ -115,6 +115,12 @@ struct PairRegistration {
 /// A translation peak's rival up to this share of its height leaves the reading unambiguous.
 constexpr double kCompetingTranslationPeak = 0.5;
 
+/// Another depth layer of one motion moves along the same direction at most this many times as
+/// far as the followed layer, or this fraction of it (tops up to half the distance to the
+/// ground). A peak on the direction beyond that is not a layer of the motion: a periodic
+/// texture's alias.
+constexpr double kMaxDepthLayerRatio = 2.0;
+
 /// What the motion so far predicts for a pair's rotation and zoom. The rotation/zoom surface's
 /// highest values within the window are tried, and last the predicted rotation and zoom
 /// themselves: low overlap, weak texture and repetitive patterns weaken the true rotation/zoom
