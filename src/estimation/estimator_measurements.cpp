@@ -20,6 +20,26 @@ constexpr double kMinLayerGatePx = 1.5;
 // layer the PMT read: a normal error stays within three sigmas 99.7 % of the time.
 constexpr double kPmtGateSigmas = 3.0;
 
+// The followed layer's own peak in pair 1-2's translation energy vector within
+// tracking.layer_gate of `length` [px] (the predicted one), down to tracking.layer_min_fraction
+// of the vector's maximum, as the step of that length along `measured`; none where the
+// measurement lies within the gate already or no such peak is there.
+std::optional<PairMotion> followedLayerTrace(const PairMotion& measured, const PairRegistration& registration,
+                                             double length, const EstimatorConfig& config, double shift_per_bin) {
+  const double gate = config.tracking.layer_gate * length;
+  if (!(shift_per_bin > 0.0) || !(measured.shift() > 0.0) || !(std::fabs(measured.shift() - length) > gate)) {
+    return std::nullopt;
+  }
+  const std::optional<double> bin = peakNear(registration.translation_energy, length / shift_per_bin,
+                                             gate / shift_per_bin, config.tracking.layer_min_fraction);
+  if (!bin) return std::nullopt;
+  const double trace = *bin * shift_per_bin;
+  // As steadyLayerStep's followed peak: twice the correlation peak's sigma along.
+  const double across = std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0));
+  return withLength(measured, trace, std::max(2.0 * alongTrackSigma(measured), kMinShiftSigma),
+                    std::max(across * trace / measured.shift(), kMinShiftSigma));
+}
+
 // observe() with a predicted translation: which peak is the followed layer's (see the header).
 // Depth layers of one motion lie along one direction at different lengths: the length tells the
 // layer; the direction only has to be the motion's (within the acceleration window).
@@ -96,9 +116,20 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   const bool on_direction = measured.shift() > 0.0 && alongMotion(measured.translation);
   const std::vector<float> none;
   LengthSource layered_source = LengthSource::kPrediction;
-  const PairMotion layered =
+  PairMotion layered =
       steadyLayerStep(measured, registration, ref.translation_energy ? *ref.translation_energy : none,
                       length, config, shift_per_bin, intervals, &layered_source);
+  if (layered.translation == measured.translation && on_direction && !skipped_frames &&
+      cv::norm(measured.translation - predicted) <= prior.translation_radius) {
+    // The peak would be read as a change of speed, the strongest claim one pair can make. Where
+    // the followed layer still leaves a trace at the predicted length, too small to carry a step
+    // by itself but a depth layer by the energy vector's own measure, the layer is in view and the
+    // speed did not change: the peak is another layer's or an alias.
+    if (const std::optional<PairMotion> trace = followedLayerTrace(measured, registration, length, config, shift_per_bin)) {
+      layered = *trace;
+      layered_source = LengthSource::kEnergyPeak;
+    }
+  }
   // The energy vectors' stretch, where it differs from the peak's: the peak is another layer.
   const bool pmt_says_other_layer =
       pmt.valid && std::fabs(measured.shift() - pmt_length) > gate &&

@@ -140,8 +140,11 @@ struct Reference {
 /// in view: the layers of steadyLayerStep (the followed layer's trace in the energy vector, or a
 /// layer seen in both pairs) give its length and the correlation peak its direction if that
 /// lies on the predicted one (another layer of the same motion; otherwise nothing of it: a
-/// repetitive texture's alias); where no layer tells, a correlation peak within the
-/// acceleration window stands (the motion changed), else the prediction's length. Not over
+/// repetitive texture's alias); where no layer tells, a correlation peak on the direction within
+/// the acceleration window stands (the motion changed), unless the followed layer leaves a trace
+/// at the predicted length: an energy peak within tracking.layer_gate of it that reaches
+/// tracking.layer_min_fraction of the maximum (the layer is in view, the speed did not change,
+/// and its trace gives the length); else the prediction's length. Not over
 /// `skipped_frames` (the pair spans frames that were not registered): there the prediction
 /// reaches further, its acceleration window grew with the square of the time, and a peak inside
 /// it says less of a change of speed than a pair over one interval does. The prediction's length

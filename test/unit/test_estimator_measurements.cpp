@@ -303,6 +303,28 @@ TEST(ObserveFollowedLayer, SaysWhetherTheSpeedChangedOrThePredictionStands) {
 // of speed (an alias at 56 % of the predicted two-interval length passed as one). The
 // prediction's length stands, the peak's direction is kept, and the next pair over one interval
 // reads the change if there was one.
+// The pair's only strong peak lies 14 % beyond the predicted 132 px, on the motion and inside
+// its acceleration window: a change of speed, unless the followed layer is still in view. Its
+// trace at 130 px, a fiftieth of the highest peak (too small to carry a step by itself:
+// tracking.steady_layer_min_fraction), is a depth layer by the energy vector's own measure
+// (tracking.layer_min_fraction): the speed did not change, and the trace gives the length. A
+// two-hundredth is not a layer, and the change of speed stands.
+TEST(ObserveFollowedLayer, TheFollowedLayersTraceRefutesAChangeOfSpeed) {
+  const EstimatorConfig config;
+  ASSERT_LT(config.tracking.layer_min_fraction, 0.02);
+  ASSERT_GT(config.tracking.steady_layer_min_fraction, 0.02);
+  PairRegistration traced = withPeaks({{150.0, 1.0}, {130.0, 0.02}});
+  traced.translation = {150.0, 0.0};
+  PairObservations obs;
+  EXPECT_NEAR(observedAfter132(predicted132(0.5, 30.0), 0.3, traced, 0.0, 0.0, &obs).shift(), 130.0, 0.05);
+  EXPECT_EQ(obs.length_source, LengthSource::kEnergyPeak);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
+  PairRegistration untraced = withPeaks({{150.0, 1.0}, {130.0, 0.005}});
+  untraced.translation = {150.0, 0.0};
+  EXPECT_NEAR(observedAfter132(predicted132(0.5, 30.0), 0.3, untraced, 0.0, 0.0, &obs).shift(), 150.0, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kMotionChange);
+}
+
 TEST(ObserveFollowedLayer, NoChangeOfSpeedIsReadOverSkippedFrames) {
   PairRegistration registration = withPeaks({{150.0, 1.0}});
   registration.translation = {150.0, 0.0};
