@@ -20,6 +20,14 @@ constexpr double kMinLayerGatePx = 1.5;
 // layer the PMT read: a normal error stays within three sigmas 99.7 % of the time.
 constexpr double kPmtGateSigmas = 3.0;
 
+// `step` at the `length` [px] a depth layer's energy peak gave it: that layer's lower peak is
+// less sharp than the correlation peak, twice its sigma along the step.
+PairMotion atLayerLength(const PairMotion& step, double length) {
+  const double across = std::sqrt(std::max(cv::trace(step.translation_covariance), 0.0));
+  return withLength(step, length, std::max(2.0 * alongTrackSigma(step), kMinShiftSigma),
+                    std::max(across * length / step.shift(), kMinShiftSigma));
+}
+
 // The followed layer's own peak in pair 1-2's translation energy vector within
 // tracking.layer_gate of `length` [px] (the predicted one), down to tracking.layer_min_fraction
 // of the vector's maximum, as the step of that length along `measured`; none where the
@@ -33,11 +41,7 @@ std::optional<PairMotion> followedLayerTrace(const PairMotion& measured, const P
   const std::optional<double> bin = peakNear(registration.translation_energy, length / shift_per_bin,
                                              gate / shift_per_bin, config.tracking.layer_min_fraction);
   if (!bin) return std::nullopt;
-  const double trace = *bin * shift_per_bin;
-  // As steadyLayerStep's followed peak: twice the correlation peak's sigma along.
-  const double across = std::sqrt(std::max(cv::trace(measured.translation_covariance), 0.0));
-  return withLength(measured, trace, std::max(2.0 * alongTrackSigma(measured), kMinShiftSigma),
-                    std::max(across * trace / measured.shift(), kMinShiftSigma));
+  return atLayerLength(measured, *bin * shift_per_bin);
 }
 
 // observe() with a predicted translation: which peak is the followed layer's (see the header).
@@ -437,11 +441,7 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
   }
   if (!ratio) return candidate;
   if (source != nullptr) *source = own ? LengthSource::kEnergyPeak : LengthSource::kLayerRatio;
-  const double steady_length = steady * *ratio;
-  // As for a followed layer's peak in observe(): twice the correlation peak's sigma along.
-  const double across = std::sqrt(std::max(cv::trace(candidate.translation_covariance), 0.0));
-  return withLength(candidate, steady_length, std::max(2.0 * alongTrackSigma(candidate), kMinShiftSigma),
-                    std::max(across * steady_length / length, kMinShiftSigma));
+  return atLayerLength(candidate, steady * *ratio);
 }
 
 }  // namespace detail
