@@ -555,7 +555,12 @@ PairMotion Estimator::State::consistentRates(const PairMotion& step, double rate
   // reading's place, as without a gyro: the gyro's bias stays out of it.
   const bool rate_changed =
       gyro_turn && turn_deviations.beyondGate(wrapToPi(prior12->rotation - rates_rotation));
-  if (!rate_changed && turn_deviations.outlier(wrapToPi(step.rotation - rates_rotation))) {
+  // A second turn in a row beyond the gate is a change of the rate only off a pair that
+  // registered the followed layer itself. Where a layer or a pattern filling the view (tall brick
+  // tops) leaves the pairs weak, their turns are read off it, in runs of either sign, and the
+  // second of a run is no change of the rate.
+  if (!rate_changed && turn_deviations.outlier(wrapToPi(step.rotation - rates_rotation),
+                                               detail::lengthFromOwnPeak(est.length_source))) {
     est.turn_predicted = true;
     out.rotation = rates_rotation;
     out.rotation_sigma = std::hypot(turn_deviations.spread(), prior12->rotation_sigma);

@@ -243,6 +243,11 @@ double lengthSpread(double length, const std::vector<double>& alternatives, doub
   return spread;
 }
 
+bool lengthFromOwnPeak(LengthSource source) {
+  return source == LengthSource::kPeak || source == LengthSource::kWindowPeak ||
+         source == LengthSource::kMotionChange || source == LengthSource::kLoop;
+}
+
 bool vouchedLengthWins(double length, LengthSource source, double vouched, double steady, double layer_gate,
                        double tolerance) {
   if (!(length > 0.0) || !(vouched > 0.0) || !(steady > 0.0)) return false;
@@ -306,7 +311,8 @@ RateDeviations::RateDeviations(std::size_t frames, std::size_t support, double g
 bool RateDeviations::beyondGate(double deviation) const {
   return deviations_.size() >= support_ && std::fabs(deviation) > gate_ * spread();
 }
-bool RateDeviations::outlier(double deviation) {
+bool RateDeviations::outlier(double deviation, bool may_change_rate) {
+  if (!may_change_rate && beyondGate(deviation)) return true;
   if (!last_outlier_ && beyondGate(deviation)) {
     last_outlier_ = true;
     return true;

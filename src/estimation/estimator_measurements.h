@@ -65,8 +65,10 @@ class RateDeviations {
   RateDeviations(std::size_t frames, std::size_t support, double gate, double floor);
 
   /// Judges a reading that deviates by `deviation` from its prediction: true for an outlier
-  /// (not remembered). Any other reading is remembered.
-  bool outlier(double deviation);
+  /// (not remembered). Any other reading is remembered. A reading off a pair that cannot tell a
+  /// change of the rate (`may_change_rate` false) is an outlier wherever it lies beyond the gate,
+  /// however many came before it, and leaves the record untouched.
+  bool outlier(double deviation, bool may_change_rate = true);
   /// Whether `deviation` lies beyond the gate, judged without remembering it (false until the
   /// support is known).
   bool beyondGate(double deviation) const;
@@ -106,6 +108,13 @@ double lengthSpread(double length, const std::vector<double>& alternatives, doub
 /// tolerance) and the step lies clearly further from the prediction: on a periodic texture an
 /// alias of the followed layer stands within the gate, its peak low, wherever that layer has left
 /// the view.
+/// Whether a step's length came from its pair's own translation peak (the correlation peak, the
+/// window's peak, a change of speed, or the loop over it) rather than from a weaker reading (a
+/// layer's energy peak, a layer ratio, the stretch, the vouched ratios, the prediction): only such
+/// a pair registered the followed layer itself, and only its turn can tell a change of the turn
+/// rate from a reading of another layer or an alias.
+bool lengthFromOwnPeak(LengthSource source);
+
 bool vouchedLengthWins(double length, LengthSource source, double vouched, double steady, double layer_gate,
                        double tolerance);
 

@@ -462,6 +462,35 @@ TEST(RateDeviations, TellsOneOutlierTurnFromAChangeOfTheRate) {
 constexpr double kSteady = 132.1, kVouched = 132.4, kAlias = 125.9;
 constexpr double kGate = 0.05, kRatioTolerance = 0.01;
 
+// Off pairs that did not register the followed layer itself (their step's length came from a
+// weaker reading), turns beyond the gate are outliers however many come in a row, and they leave
+// the record as it was: the next pair that reads its own peak is judged as if they had not been.
+TEST(RateDeviations, OnlyAPairThatReadItsOwnPeakChangesTheRate) {
+  const double degree = CV_PI / 180.0;
+  detail::RateDeviations turns(12, 6, 4.0, 0.001 * degree);
+  for (double d : {0.010, -0.012, 0.006, -0.004, 0.011, -0.009, 0.008, -0.010}) {
+    EXPECT_FALSE(turns.outlier(d * degree));
+  }
+  const double spread = turns.spread();
+  EXPECT_TRUE(turns.outlier(-0.5 * degree, false));
+  EXPECT_TRUE(turns.outlier(-0.5 * degree, false)) << "a second one off a weak pair is no change";
+  EXPECT_TRUE(turns.outlier(0.5 * degree, false));
+  EXPECT_DOUBLE_EQ(turns.spread(), spread);
+  EXPECT_FALSE(turns.outlier(3.5 * spread, false)) << "within the gate a weak pair's turn stands";
+  // The weak pairs counted for nothing: a strong pair's turn beyond the gate is a first outlier,
+  // the next one a change of the rate.
+  EXPECT_TRUE(turns.outlier(-0.5 * degree));
+  EXPECT_FALSE(turns.outlier(-0.5 * degree));
+  EXPECT_TRUE(detail::lengthFromOwnPeak(LengthSource::kPeak));
+  EXPECT_TRUE(detail::lengthFromOwnPeak(LengthSource::kWindowPeak));
+  EXPECT_TRUE(detail::lengthFromOwnPeak(LengthSource::kMotionChange));
+  EXPECT_TRUE(detail::lengthFromOwnPeak(LengthSource::kLoop));
+  for (LengthSource weak : {LengthSource::kEnergyPeak, LengthSource::kLayerRatio, LengthSource::kStretch,
+                            LengthSource::kPrediction, LengthSource::kVouched, LengthSource::kImplausible}) {
+    EXPECT_FALSE(detail::lengthFromOwnPeak(weak));
+  }
+}
+
 TEST(VouchedLength, AWeakReadingWithinTheGateGivesWayWhereTheLayersAndTheMotionAgree) {
   EXPECT_TRUE(detail::vouchedLengthWins(kAlias, LengthSource::kEnergyPeak, kVouched, kSteady, kGate, kRatioTolerance));
   EXPECT_TRUE(detail::vouchedLengthWins(kAlias, LengthSource::kLayerRatio, kVouched, kSteady, kGate, kRatioTolerance));
