@@ -98,6 +98,13 @@ ShiftMatchOptions shiftOptions(const MatchingConfig& matching);
 /// non-positive or non-finite alternatives are ignored.
 double lengthSpread(double length, const std::vector<double>& alternatives, double layer_gate, double window);
 
+/// Whether a step's length came from its pair's own translation peak (the correlation peak, the
+/// window's peak, a change of speed, or the loop over it) rather than from a weaker reading (a
+/// layer's energy peak, a layer ratio, the stretch, the vouched ratios, the prediction): only such
+/// a pair registered the followed layer itself, and only its turn can tell a change of the turn
+/// rate from a reading of another layer or an alias.
+bool lengthFromOwnPeak(LengthSource source);
+
 /// Whether a step of `length` [px], read off `source`, gives way to the `vouched` length (the
 /// ratios the layers in view held over the last steps, LayerRatioMemory). `steady` is the length
 /// the motion so far predicts; `tolerance` the ratios' own (relative). The layers mend a step that
@@ -108,13 +115,6 @@ double lengthSpread(double length, const std::vector<double>& alternatives, doub
 /// tolerance) and the step lies clearly further from the prediction: on a periodic texture an
 /// alias of the followed layer stands within the gate, its peak low, wherever that layer has left
 /// the view.
-/// Whether a step's length came from its pair's own translation peak (the correlation peak, the
-/// window's peak, a change of speed, or the loop over it) rather than from a weaker reading (a
-/// layer's energy peak, a layer ratio, the stretch, the vouched ratios, the prediction): only such
-/// a pair registered the followed layer itself, and only its turn can tell a change of the turn
-/// rate from a reading of another layer or an alias.
-bool lengthFromOwnPeak(LengthSource source);
-
 bool vouchedLengthWins(double length, LengthSource source, double vouched, double steady, double layer_gate,
                        double tolerance);
 
