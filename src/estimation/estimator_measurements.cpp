@@ -118,13 +118,16 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   // The followed layer is not in view. A correlation peak along the motion is another layer of
   // it (its direction holds); off it, an alias (nothing of it holds).
   const bool on_direction = measured.shift() > 0.0 && alongMotion(measured.translation);
+  // A peak the vehicle can reach, read off a pair over one frame interval only, may be a change
+  // of speed where no layer tells the followed one's length.
+  const bool speed_change_in_reach = on_direction && !skipped_frames &&
+                                     cv::norm(measured.translation - predicted) <= prior.translation_radius;
   const std::vector<float> none;
   LengthSource layered_source = LengthSource::kPrediction;
   PairMotion layered =
       steadyLayerStep(measured, registration, ref.translation_energy ? *ref.translation_energy : none,
                       length, config, shift_per_bin, intervals, &layered_source);
-  if (layered.translation == measured.translation && on_direction && !skipped_frames &&
-      cv::norm(measured.translation - predicted) <= prior.translation_radius) {
+  if (layered.translation == measured.translation && speed_change_in_reach) {
     // The peak would be read as a change of speed, the strongest claim one pair can make. Where
     // the followed layer still leaves a trace at the predicted length, too small to carry a step
     // by itself but a depth layer by the energy vector's own measure, the layer is in view and the
@@ -139,9 +142,9 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
       pmt.valid && std::fabs(measured.shift() - pmt_length) > gate &&
       std::fabs(pmt_length - length) <= prior.translation_radius;
   if (layered.translation == measured.translation && !pmt_says_other_layer) {
-    // No layer tells the followed one's length: a peak the vehicle can reach is the motion's
-    // change (its layer is followed from here), read off a pair over one frame interval only.
-    if (on_direction && !skipped_frames && cv::norm(measured.translation - predicted) <= prior.translation_radius) {
+    // No layer tells the followed one's length: the peak is the motion's change (its layer is
+    // followed from here).
+    if (speed_change_in_reach) {
       obs.length_source = LengthSource::kMotionChange;
       return;
     }

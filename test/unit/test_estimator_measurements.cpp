@@ -145,6 +145,7 @@ PairMotion observedAfter132(const RegistrationPrior& prior, double shift_sigma,
   pmt.sigma = pmt_sigma;
   PairMotion initial;
   PairMotion measured = motionAlongX(registration.translation.x);
+  measured.translation = registration.translation;  // off the x axis too (an alias off the motion)
   measured.log_zoom = log_zoom;
   measured.log_zoom_sigma = 1e-3;
   const PairObservations obs =
@@ -264,17 +265,7 @@ TEST(ObserveFollowedLayer, AnAliasesZoomGivesWayToThePrediction) {
     registration.followed_translation = {131.0, 0.0};
     registration.followed_confidence = 1.0;
     PairObservations obs;
-    detail::Reference ref;
-    ref.translation = {132.0, 0.0};
-    ref.shift = 132.0;
-    ref.shift_sigma = 0.3;
-    PairMotion measured = motionAlongX(1.0);
-    measured.translation = alias;
-    measured.log_zoom = alias_zoom;
-    measured.log_zoom_sigma = 1e-3;
-    PairMotion initial;
-    obs = detail::observe(registration, measured, MatchResult(), MatchResult(), ref, EstimatorConfig(),
-                          kShiftPerBin, 1.0, 1.0, &prior, initial, false);
+    const PairMotion initial = observedAfter132(prior, 0.3, registration, 0.0, 0.0, &obs, alias_zoom);
     ASSERT_EQ(obs.length_source, LengthSource::kWindowPeak) << alias;
     ASSERT_FALSE(obs.log_zoom.empty());
     EXPECT_DOUBLE_EQ(obs.log_zoom.front().value, prior.log_zoom) << alias;
@@ -298,11 +289,6 @@ TEST(ObserveFollowedLayer, SaysWhetherTheSpeedChangedOrThePredictionStands) {
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
 }
 
-// The same peak over a pair that spans a frame that failed: the prediction reaches twice as far
-// and its acceleration window four times as wide, so a peak inside it is no reading of a change
-// of speed (an alias at 56 % of the predicted two-interval length passed as one). The
-// prediction's length stands, the peak's direction is kept, and the next pair over one interval
-// reads the change if there was one.
 // The pair's only strong peak lies 14 % beyond the predicted 132 px, on the motion and inside
 // its acceleration window: a change of speed, unless the followed layer is still in view. Its
 // trace at 130 px, a fiftieth of the highest peak (too small to carry a step by itself:
@@ -325,6 +311,11 @@ TEST(ObserveFollowedLayer, TheFollowedLayersTraceRefutesAChangeOfSpeed) {
   EXPECT_EQ(obs.length_source, LengthSource::kMotionChange);
 }
 
+// The same peak over a pair that spans a frame that failed: the prediction reaches twice as far
+// and its acceleration window four times as wide, so a peak inside it is no reading of a change
+// of speed (an alias at 56 % of the predicted two-interval length passed as one). The
+// prediction's length stands, the peak's direction is kept, and the next pair over one interval
+// reads the change if there was one.
 TEST(ObserveFollowedLayer, NoChangeOfSpeedIsReadOverSkippedFrames) {
   PairRegistration registration = withPeaks({{150.0, 1.0}});
   registration.translation = {150.0, 0.0};
