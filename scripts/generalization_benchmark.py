@@ -170,19 +170,27 @@ HOLDOUT = [
 # layers are in view when, and which of them a brick or tile lattice aliases, differ from render
 # to render, and one flight of a kind says little about the next (--subset periodic). Four kinds
 # of the corpus and holdout, each on six seeds neither uses. No requirement is asserted on them;
-# a change to how the scale is kept is judged by their spread and worst case.
-PERIODIC = [
-    flight(f"p-{kind}-{seed}", what, *options, "--seed", str(seed))
-    for seed in range(61, 67)
-    for kind, what, options in (
-        ("eight-tiles-walls", "figure-8, tiles on every layer, walls",
-         ("--track", "eight", "--texture-style", "tiles", "--walls")),
-        ("circle-brick", "brick on every layer", ("--texture-style", "brick")),
-        ("eight-ov70-brick", "figure-8, overlap 70 %, brick on every layer",
-         ("--track", "eight", "--overlap", "0.7", "--texture-style", "brick")),
-        ("circle-tiles", "tiles on every layer", ("--texture-style", "tiles")),
-    )
-]
+# a change to how the scale is kept is judged by their spread and worst case. --periodic-seeds
+# renders the same kinds on other seeds, for a second sample of the class.
+PERIODIC_SEEDS = (61, 66)
+
+
+def periodic_flights(first, last):
+    return [
+        flight(f"p-{kind}-{seed}", what, *options, "--seed", str(seed))
+        for seed in range(first, last + 1)
+        for kind, what, options in (
+            ("eight-tiles-walls", "figure-8, tiles on every layer, walls",
+             ("--track", "eight", "--texture-style", "tiles", "--walls")),
+            ("circle-brick", "brick on every layer", ("--texture-style", "brick")),
+            ("eight-ov70-brick", "figure-8, overlap 70 %, brick on every layer",
+             ("--track", "eight", "--overlap", "0.7", "--texture-style", "brick")),
+            ("circle-tiles", "tiles on every layer", ("--texture-style", "tiles")),
+        )
+    ]
+
+
+PERIODIC = periodic_flights(*PERIODIC_SEEDS)
 
 # A flight flown again with a downward rangefinder (--rangefinder) is rendered under its name with
 # this suffix, beside the plain render.
@@ -309,6 +317,10 @@ def main():
     parser.add_argument("--subset", choices=("full", "ci", "holdout", "periodic"), default="full",
                         help="the corpus, the test command's part of it, the flights outside it, or "
                         "periodic textures on every layer on further seeds")
+    parser.add_argument("--periodic-seeds", metavar="FIRST-LAST",
+                        default=f"{PERIODIC_SEEDS[0]}-{PERIODIC_SEEDS[1]}",
+                        help="the seeds of --subset periodic (default %(default)s; the corpus and "
+                        "holdout use seeds up to 60)")
     parser.add_argument("--flights", help="comma-separated flight names (instead of --subset)")
     parser.add_argument("--rangefinder", action="store_true",
                         help="the same flights with a downward rangefinder (range.txt, read by "
@@ -329,7 +341,13 @@ def main():
     work = args.work or os.path.join(source, "build", "generalization")
     os.makedirs(work, exist_ok=True)
     modes = args.modes.split(",")
-    subsets = {"holdout": HOLDOUT, "periodic": PERIODIC}
+    try:
+        first, last = (int(value) for value in args.periodic_seeds.split("-"))
+    except ValueError:
+        parser.error(f"--periodic-seeds: expected FIRST-LAST (two whole numbers), got {args.periodic_seeds!r}")
+    if first > last:
+        parser.error(f"--periodic-seeds: the first seed {first} is above the last {last}")
+    subsets = {"holdout": HOLDOUT, "periodic": periodic_flights(first, last)}
     pool = CORPUS + HOLDOUT + PERIODIC if args.flights else subsets.get(args.subset, CORPUS)
     if args.list:
         for entry in pool:
