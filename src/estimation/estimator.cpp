@@ -128,6 +128,7 @@ struct Estimator::State {
     implausible_steps = 0;
     unconfirmed_steps = 0;
     ambiguous_motion = false;
+    doubt_log_share = 0.0;
     started = false;
     last_stamp = -std::numeric_limits<double>::infinity();
   }
@@ -285,8 +286,10 @@ struct Estimator::State {
   LayerRatioMemory layer_ratios{kLayerRatioFrames, kLayerRatioSupport, kLayerRatioTolerance};
   int unconfirmed_steps = 0;  // steps in a row that did not enter recent_steps
   // The translations since the last start rest on a reading that a rival peak matched as well
-  // (RegistrationPrior::translation_ambiguous).
+  // (RegistrationPrior::translation_ambiguous), and how the prediction's peak fared against the
+  // other readings since (RegistrationPrior::doubt_log_share).
   bool ambiguous_motion = false;
+  double doubt_log_share = 0.0;
   bool started = false;
   double last_stamp = -std::numeric_limits<double>::infinity();
 
@@ -586,10 +589,16 @@ void Estimator::State::slideTo(WindowFrame&& frame, const PairMotion& predicted)
 bool Estimator::State::weighAmbiguity(Estimate& est) {
   const PairRegistration& r = est.registration12;
   if (!r.translation_unrivalled) {
-    if (!(prior12 && prior12->translation_radius > 0.0)) ambiguous_motion = r.uniqueness() < 1.0;
+    if (!(prior12 && prior12->translation_radius > 0.0)) {
+      ambiguous_motion = r.uniqueness() < 1.0;
+      doubt_log_share = 0.0;
+    } else if (ambiguous_motion && prior12->translation_ambiguous && r.prediction_share > 0.0) {
+      doubt_log_share += std::log(std::clamp(r.prediction_share, 1.0 / kMaxDoubtShare, kMaxDoubtShare));
+    }
     return false;
   }
   ambiguous_motion = false;
+  doubt_log_share = 0.0;
   if (!prior12 || !(cv::norm(r.translation - prior12->translation) > prior12->translation_radius)) return false;
   // The motion so far followed a periodic texture's alias: the window starts over from frame 1
   // with this pair, as after a restart (the poses before stay as integrated).
@@ -1026,7 +1035,10 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     RegistrationSurfaces* surfaces = nullptr;
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
-    if (s.prior12) s.prior12->translation_ambiguous = s.ambiguous_motion;
+    if (s.prior12) {
+      s.prior12->translation_ambiguous = s.ambiguous_motion;
+      s.prior12->doubt_log_share = s.doubt_log_share;
+    }
     double rates_rotation12 = s.prior12 ? s.prior12->rotation : 0.0;
     if (turn12 && s.prior12) s.takeTurn(*s.prior12, -turn12->first, turn12->second);
     bool gyro_turn12 = turn12.has_value();

@@ -618,8 +618,15 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
     findRival(peak, peak_floor(kTranslationPsrFloor), result);
     const double near_ratio = overlapNormalisedHeight(near) / overlapNormalisedHeight(peak);
     const bool same = std::abs(near.row - peak.row) <= 1 && std::abs(near.col - peak.col) <= 1;
-    if (result.rival_ratio < 1.0 &&
-        (near_ratio <= kCompetingTranslationPeak || (same && result.uniqueness() >= 1.0))) {
+    result.prediction_share =
+        same ? (result.rival_ratio > 0.0 ? 1.0 / result.rival_ratio : kMaxDoubtShare) : near_ratio;
+    // The share must hold over the pairs since the start too. A start on the motion whose lattice
+    // alias rivals it stays doubted while the alias stands beside the motion's peak; where that
+    // alias outgrows the motion's peak in one pair after the motion's stood highest in the pairs
+    // before, one pair's heights do not make the motion so far an alias.
+    const double record = std::log(std::max(near_ratio, 1.0 / kMaxDoubtShare)) + prior->doubt_log_share;
+    const bool leaves = near_ratio <= kCompetingTranslationPeak && record <= std::log(kCompetingTranslationPeak);
+    if (result.rival_ratio < 1.0 && (leaves || (same && result.uniqueness() >= 1.0))) {
       result.translation_unrivalled = true;
       return global;
     }

@@ -85,6 +85,12 @@ struct PairRegistration {
   /// reading, or the prediction's and unrivalled (RegistrationPrior::translation_ambiguous), and
   /// was taken. rival_ratio is then its rival's. The estimator's doubt about its start ends.
   bool translation_unrivalled = false;
+  /// With a prior whose translation was ambiguous: the prediction's own peak against the
+  /// strongest other reading, both by overlap-normalised height. Below 1 where the surface's
+  /// highest peak is another (the prediction's share of it), above 1 where the prediction's peak
+  /// is the highest (its height over its rival's); 0: not measured. The estimator keeps the
+  /// record of these over the pairs since the doubted start (RegistrationPrior::doubt_log_share).
+  double prediction_share = 0.0;
   /// How much the taken peak stands above its rival: 1 when the rival reaches at most
   /// kCompetingTranslationPeak of its height, 0 when it is as high.
   double uniqueness() const;
@@ -114,6 +120,10 @@ struct PairRegistration {
 
 /// A translation peak's rival up to this share of its height leaves the reading unambiguous.
 constexpr double kCompetingTranslationPeak = 0.5;
+/// One pair's PairRegistration::prediction_share counts in RegistrationPrior::doubt_log_share
+/// within a factor of this either way: a pair where the prediction's peak is all but missing
+/// (a frame the texture leaves flat) says no more than that it fell well behind.
+constexpr double kMaxDoubtShare = 10.0;
 
 /// Another depth layer of one motion moves along the same direction at most this many times as
 /// far as the followed layer, or this fraction of it (tops up to half the distance to the
@@ -158,10 +168,15 @@ struct RegistrationPrior {
   /// The motion so far rests on readings that a rival peak matched as well (a periodic texture
   /// since the last start): the prediction may follow an alias. The surface's highest peak is
   /// then taken wherever it lies when no peak outdoes it as PairRegistration::rival_ratio
-  /// measures and the window's peak reaches at most kCompetingTranslationPeak of it, or when it
-  /// is the window's peak and nothing rivals it, which confirms the prediction
+  /// measures and the window's peak reaches at most kCompetingTranslationPeak of it, in this
+  /// pair and over the pairs since the start (doubt_log_share), or when it is the window's peak
+  /// and nothing rivals it, which confirms the prediction
   /// (PairRegistration::translation_unrivalled).
   bool translation_ambiguous = false;
+  /// With translation_ambiguous: the sum of ln PairRegistration::prediction_share over the
+  /// pairs since the doubted start, each within a factor of kMaxDoubtShare either way. Above 0
+  /// where the prediction's peak stood above the other readings more than it fell behind them.
+  double doubt_log_share = 0.0;
 };
 
 /// The shifts [px] of a registered pair's other depth layers, which the zoom refinement tests its
