@@ -17,6 +17,7 @@ if(TARGET oefmt_tool_tests)
     OEFMT_FOLDER_TO_BAG="$<TARGET_FILE:oefmt_folder_to_bag>"
     OEFMT_EVALUATE="$<TARGET_FILE:oefmt_evaluate>"
     OEFMT_OFFLINE="$<TARGET_FILE:oefmt_offline>"
-    OEFMT_MEASURE_SPEED="${PROJECT_SOURCE_DIR}/scripts/measure_speed.py")
+    OEFMT_MEASURE_SPEED="${PROJECT_SOURCE_DIR}/scripts/measure_speed.py"
+    OEFMT_GENERALIZATION_BENCHMARK="${PROJECT_SOURCE_DIR}/scripts/generalization_benchmark.py")
   add_dependencies(oefmt_tool_tests oefmt_simulate oefmt_folder_to_bag oefmt_evaluate oefmt_offline)
 endif()

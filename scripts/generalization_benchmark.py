@@ -347,8 +347,9 @@ def main():
         parser.error(f"--periodic-seeds: expected FIRST-LAST (two whole numbers), got {args.periodic_seeds!r}")
     if first > last:
         parser.error(f"--periodic-seeds: the first seed {first} is above the last {last}")
-    subsets = {"holdout": HOLDOUT, "periodic": periodic_flights(first, last)}
-    pool = CORPUS + HOLDOUT + PERIODIC if args.flights else subsets.get(args.subset, CORPUS)
+    periodic = periodic_flights(first, last)
+    subsets = {"holdout": HOLDOUT, "periodic": periodic}
+    pool = CORPUS + HOLDOUT + periodic if args.flights else subsets.get(args.subset, CORPUS)
     if args.list:
         for entry in pool:
             print(f"{entry['name']:{NAME_WIDTH}s} {entry['what']:55s} {' '.join(entry['options'])}")

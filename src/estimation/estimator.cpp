@@ -593,7 +593,7 @@ bool Estimator::State::weighAmbiguity(Estimate& est) {
       ambiguous_motion = r.uniqueness() < 1.0;
       doubt_log_share = 0.0;
     } else if (ambiguous_motion && prior12->translation_ambiguous && r.prediction_share > 0.0) {
-      doubt_log_share += std::log(std::clamp(r.prediction_share, 1.0 / kMaxDoubtShare, kMaxDoubtShare));
+      doubt_log_share += doubtLogShare(r.prediction_share);
     }
     return false;
   }

@@ -624,7 +624,7 @@ double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfaceP
     // alias rivals it stays doubted while the alias stands beside the motion's peak; where that
     // alias outgrows the motion's peak in one pair after the motion's stood highest in the pairs
     // before, one pair's heights do not make the motion so far an alias.
-    const double record = std::log(std::max(near_ratio, 1.0 / kMaxDoubtShare)) + prior->doubt_log_share;
+    const double record = doubtLogShare(result.prediction_share) + prior->doubt_log_share;
     const bool leaves = near_ratio <= kCompetingTranslationPeak && record <= std::log(kCompetingTranslationPeak);
     if (result.rival_ratio < 1.0 && (leaves || (same && result.uniqueness() >= 1.0))) {
       result.translation_unrivalled = true;
@@ -700,6 +700,10 @@ void Registrar::findRival(const SurfacePeak& taken, float floor, PairRegistratio
       }
     }
   }
+}
+
+double doubtLogShare(double prediction_share) {
+  return std::log(std::clamp(prediction_share, 1.0 / kMaxDoubtShare, kMaxDoubtShare));
 }
 
 double PairRegistration::uniqueness() const {

@@ -594,5 +594,34 @@ TEST(Tools, MeasureSpeedReportsEveryRun) {
   EXPECT_EQ(failed.err.find("Traceback"), std::string::npos) << failed.err;
 }
 
+// scripts/generalization_benchmark.py --periodic-seeds: the periodic kinds on the seeds asked
+// for (in --subset periodic, and among the flights --flights names), and a usage error naming the
+// option for anything else.
+TEST(Tools, GeneralizationBenchmarkTakesOtherPeriodicSeeds) {
+  TempDir dir;
+  const std::string script = std::string("python3 ") + OEFMT_GENERALIZATION_BENCHMARK + " --work " + (dir / "work");
+  const ToolRun listed = run(dir, script + " --subset periodic --periodic-seeds 67-68 --list");
+  ASSERT_EQ(listed.status, 0) << listed.err;
+  EXPECT_EQ(std::count(listed.out.begin(), listed.out.end(), '\n'), 8) << "four kinds on two seeds:\n" << listed.out;
+  for (const char* expected : {"p-circle-brick-67 ", "--seed 67", "p-circle-tiles-68 ", "--seed 68"}) {
+    EXPECT_NE(listed.out.find(expected), std::string::npos) << expected << " in\n" << listed.out;
+  }
+  EXPECT_EQ(listed.out.find("-66 "), std::string::npos) << "not the default seeds:\n" << listed.out;
+  const ToolRun by_name =
+      run(dir, script + " --periodic-seeds 67-68 --flights p-eight-ov70-brick-67 --list");
+  ASSERT_EQ(by_name.status, 0) << by_name.err;
+  EXPECT_NE(by_name.out.find("p-eight-ov70-brick-67 "), std::string::npos) << by_name.out;
+
+  for (const auto& [seeds, message] : std::vector<std::pair<std::string, std::string>>{
+           {"67", "--periodic-seeds: expected FIRST-LAST (two whole numbers), got '67'"},
+           {"a-b", "--periodic-seeds: expected FIRST-LAST (two whole numbers), got 'a-b'"},
+           {"70-67", "--periodic-seeds: the first seed 70 is above the last 67"}}) {
+    const ToolRun bad = run(dir, script + " --subset periodic --list --periodic-seeds " + seeds);
+    EXPECT_EQ(bad.status, 2) << seeds;
+    EXPECT_NE(bad.err.find(message), std::string::npos) << bad.err;
+    EXPECT_EQ(bad.err.find("Traceback"), std::string::npos) << bad.err;
+  }
+}
+
 }  // namespace
 }  // namespace oefmt

@@ -113,7 +113,7 @@ TEST(TranslationRivals, AnAmbiguousPredictionGivesWayToABetterPeak) {
 
   // Pairs since the start where the prediction's peak stood above the others keep it against
   // this one, until this pair's share and theirs together reach the competitor's share.
-  const double this_pair = std::log(std::max(doubted.prediction_share, 1.0 / kMaxDoubtShare));
+  const double this_pair = doubtLogShare(doubted.prediction_share);
   prior.doubt_log_share = std::log(kCompetingTranslationPeak) - this_pair + 0.1;
   const PairRegistration kept = registerViews(views, &prior);
   EXPECT_FALSE(kept.translation_unrivalled) << "the record outweighs one pair";

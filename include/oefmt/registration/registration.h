@@ -124,6 +124,8 @@ constexpr double kCompetingTranslationPeak = 0.5;
 /// within a factor of this either way: a pair where the prediction's peak is all but missing
 /// (a frame the texture leaves flat) says no more than that it fell well behind.
 constexpr double kMaxDoubtShare = 10.0;
+/// ln of a PairRegistration::prediction_share as it counts in RegistrationPrior::doubt_log_share.
+double doubtLogShare(double prediction_share);
 
 /// Another depth layer of one motion moves along the same direction at most this many times as
 /// far as the followed layer, or this fraction of it (tops up to half the distance to the
