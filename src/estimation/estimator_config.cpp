@@ -161,7 +161,8 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
                       closedRange(0.0, 1.0),
                       "a step off steady speed by more than layer_gate moves to a translation energy "
                       "peak at the steady length when that peak reaches this fraction of the maximum; "
-                      "1 = only the largest peak"),
+                      "peaks this high also testify to the speed between two pairs, against a peak "
+                      "taken for the followed layer; 1 = only the largest peak"),
       integerParameter("tracking.max_failed_frames", t.max_failed_frames, "frames", closedRange(0, 1000),
                        "frames in a row that may fail to register before the window restarts from "
                        "the newest"),

@@ -19,6 +19,9 @@ constexpr double kMinLayerGatePx = 1.5;
 // A peak further than this many of the PMT's sigmas from the length the PMT reads is not the
 // layer the PMT read: a normal error stays within three sigmas 99.7 % of the time.
 constexpr double kPmtGateSigmas = 3.0;
+// How far two depth layers' speed ratios between consecutive pairs may differ [relative]: their
+// energy peaks' sub-bin noise, as the layer ratio memory's tolerance.
+constexpr double kSpeedRatioTolerance = 0.01;
 
 // `step` at the `length` [px] a depth layer's energy peak gave it: that layer's lower peak is
 // less sharp than the correlation peak, twice its sigma along the step.
@@ -26,6 +29,53 @@ PairMotion atLayerLength(const PairMotion& step, double length) {
   const double across = std::sqrt(std::max(cv::trace(step.translation_covariance), 0.0));
   return withLength(step, length, std::max(2.0 * alongTrackSigma(step), kMinShiftSigma),
                     std::max(across * length / step.shift(), kMinShiftSigma));
+}
+
+// Speed ratios of a rigid scene: a change of the vehicle's speed changes every depth layer's
+// shift by the same ratio (a climb's zoom adds a little more for the nearer layers). A candidate
+// for the followed layer's length, at `candidate_ratio` of the steady length, is another layer (a
+// wall, a neighbouring top a few per cent nearer) where at least two other layers seen in both
+// pairs (a translation energy peak of pair 1-2 with one of pair 0-1 within tracking.layer_gate of
+// it over the frame intervals, both reaching tracking.steady_layer_min_fraction) agree on another
+// ratio and none keeps the candidate's. Where walls
+// fill the energy vectors with peaks between the layers, one of them inside the gate was taken
+// for the followed layer at each pair, and the length walked from one to the next. Returns the
+// ratio the other layers agree on, or nothing where the candidate may be the followed layer.
+std::optional<double> contradictingSpeedRatio(const std::vector<float>& energy12, const std::vector<float>& energy01,
+                                              double candidate_bin, double candidate_ratio, double intervals,
+                                              double log_zoom, const TrackingConfig& tracking) {
+  if (energy12.empty() || energy01.empty() || !(intervals > 0.0) || !(candidate_ratio > 0.0)) return std::nullopt;
+  const double tolerance = kSpeedRatioTolerance + std::fabs(log_zoom);
+  // Only layers whose peaks could carry a step testify: walls leave weaker peaks at every length,
+  // and some pair of them keeps any ratio.
+  const std::vector<EnergyPeak> peaks01 = energyPeaks(energy01, tracking.steady_layer_min_fraction);
+  std::vector<double> ratios;  // per other layer of pair 1-2: its speed ratio nearest to steady speed
+  for (const EnergyPeak& p : energyPeaks(energy12, tracking.steady_layer_min_fraction)) {
+    if (std::fabs(p.bin - candidate_bin) <= 1.0) continue;  // the candidate's own peak
+    std::optional<double> nearest;
+    for (const EnergyPeak& q : peaks01) {
+      if (!(q.bin > 0.0)) continue;
+      const double r = p.bin / intervals / q.bin;
+      if (std::fabs(r - candidate_ratio) <= tolerance) return std::nullopt;  // a layer keeps its ratio
+      if (std::fabs(r - 1.0) <= tracking.layer_gate && (!nearest || std::fabs(r - 1.0) < std::fabs(*nearest - 1.0))) {
+        nearest = r;
+      }
+    }
+    if (nearest) ratios.push_back(*nearest);
+  }
+  // The largest group of ratios within the tolerance of each other, its median.
+  std::sort(ratios.begin(), ratios.end());
+  std::size_t best_first = 0, best_count = 0;
+  for (std::size_t i = 0; i < ratios.size(); ++i) {
+    std::size_t j = i;
+    while (j + 1 < ratios.size() && ratios[j + 1] - ratios[i] <= tolerance) ++j;
+    if (j - i + 1 > best_count) {
+      best_first = i;
+      best_count = j - i + 1;
+    }
+  }
+  if (best_count < 2) return std::nullopt;
+  return ratios[best_first + best_count / 2];
 }
 
 // The followed layer's own peak in pair 1-2's translation energy vector within
@@ -75,10 +125,20 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   const double pmt_sigma = pmt.valid ? std::hypot(pmt_length * pmt.sigma, pmt.value * ref.shift_sigma) : 0.0;
   const double pmt_gate = std::max(std::min(config.tracking.layer_gate * pmt_length, kPmtGateSigmas * pmt_sigma),
                                    kMinLayerGatePx);
-  const auto followed = [&](const cv::Point2d& d) {
+  const auto inGate = [&](const cv::Point2d& d) {
     return alongMotion(d) && std::fabs(cv::norm(d) - length) <= gate &&
            (!pmt_reads_layer || std::fabs(cv::norm(d) - pmt_length) <= pmt_gate);
   };
+  // Nor is a peak whose speed ratio the other layers seen in both pairs refute: the ratio they
+  // agree on gives the followed layer's length.
+  const std::vector<float> no_energy;
+  const std::vector<float>& energy01 = ref.translation_energy ? *ref.translation_energy : no_energy;
+  const auto refutingRatio = [&](const cv::Point2d& d) -> std::optional<double> {
+    if (!(length > 0.0) || !(shift_per_bin > 0.0)) return std::nullopt;
+    return contradictingSpeedRatio(registration.translation_energy, energy01, cv::norm(d) / shift_per_bin,
+                                   cv::norm(d) / length, intervals, prior.log_zoom, config.tracking);
+  };
+  const auto followed = [&](const cv::Point2d& d) { return inGate(d) && !refutingRatio(d); };
   obs.length_source = LengthSource::kPeak;
   if (followed(measured.translation)) return;  // the correlation peak is the layer's
   if (registration.followed_confidence >= config.registration.min_confidence &&
@@ -122,11 +182,18 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   // of speed where no layer tells the followed one's length.
   const bool speed_change_in_reach = on_direction && !skipped_frames &&
                                      cv::norm(measured.translation - predicted) <= prior.translation_radius;
-  const std::vector<float> none;
   LengthSource layered_source = LengthSource::kPrediction;
+  const std::optional<double> refuted =
+      inGate(measured.translation) ? refutingRatio(measured.translation) : std::nullopt;
+  // The layers' speeds are compared at the predicted zoom: a pair whose highest peak is another
+  // layer's or a wall's may have misread its zoom as well.
+  PairMotion at_predicted_zoom = measured;
+  at_predicted_zoom.log_zoom = prior.log_zoom;
   PairMotion layered =
-      steadyLayerStep(measured, registration, ref.translation_energy ? *ref.translation_energy : none,
-                      length, config, shift_per_bin, intervals, &layered_source);
+      refuted ? atLayerLength(measured, length * *refuted)
+              : steadyLayerStep(at_predicted_zoom, registration, energy01, length, config, shift_per_bin,
+                                intervals, &layered_source);
+  if (refuted) layered_source = LengthSource::kLayerRatio;
   if (layered.translation == measured.translation && speed_change_in_reach) {
     // The peak would be read as a change of speed, the strongest claim one pair can make. Where
     // the followed layer still leaves a trace at the predicted length, too small to carry a step
@@ -425,8 +492,15 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
   const double min_fraction = tracking.steady_layer_min_fraction;
   const std::optional<double> own = peakNear(registration12.translation_energy, steady / shift_per_bin,
                                              tracking.layer_gate * steady / shift_per_bin, min_fraction);
-  std::optional<double> ratio;
-  if (own) {
+  // Unless the layers seen in both pairs say it is another layer, by the speed they agree on.
+  const std::optional<double> contradicted =
+      own ? contradictingSpeedRatio(registration12.translation_energy, translation01, *own,
+                                    *own * shift_per_bin / steady, intervals, candidate.log_zoom, tracking)
+          : std::nullopt;
+  double ratio = 0.0;  // the speed ratio the step takes; none where nothing tells it
+  if (contradicted) {
+    ratio = *contradicted;
+  } else if (own) {
     ratio = *own * shift_per_bin / steady;
   } else {
     // The followed layer has left the view. The layers seen in both pairs at steady speed (a
@@ -442,15 +516,15 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
         if (!(q.bin > 0.0)) continue;
         const double r = expected / q.bin;
         if (std::fabs(r - 1.0) <= tracking.layer_gate &&
-            (!ratio || std::fabs(r - 1.0) < std::fabs(*ratio - 1.0))) {
+            (!(ratio > 0.0) || std::fabs(r - 1.0) < std::fabs(ratio - 1.0))) {
           ratio = r;
         }
       }
     }
   }
-  if (!ratio) return candidate;
-  if (source != nullptr) *source = own ? LengthSource::kEnergyPeak : LengthSource::kLayerRatio;
-  return atLayerLength(candidate, steady * *ratio);
+  if (!(ratio > 0.0)) return candidate;
+  if (source != nullptr) *source = own && !contradicted ? LengthSource::kEnergyPeak : LengthSource::kLayerRatio;
+  return atLayerLength(candidate, steady * ratio);
 }
 
 }  // namespace detail

@@ -121,6 +121,54 @@ TEST(SteadyLayerStep, TheFollowedLayerLeavingKeepsItsScale) {
   EXPECT_NEAR(changed.shift(), 119.5 * 1.6, 1e-9);
 }
 
+// Pair 0-1 of a scene with walls between its levels: the ground 92.7 px, the followed tops
+// 110.0 px, higher tops 132.5 px.
+const std::vector<float>& threeLevels01() {
+  static const std::vector<float> v = energyWithPeaks({{92.7, 1.0}, {110.0, 0.6}, {132.5, 0.5}});
+  return v;
+}
+
+// Pair 1-2 at steady speed: the followed tops have left the view, and a wall's peak stands at
+// 114.0 px, inside layer_gate of their 110.0. The ground and the higher tops keep their speed, so
+// the wall's peak is another layer: the step keeps the followed tops' length, by the speed the
+// other two agree on. Taken for the followed layer, the length moved 3.6 % with no change of
+// speed, and on from wall to wall at the next pairs. Two weak wall peaks (a fiftieth of the
+// highest, below tracking.steady_layer_min_fraction) that happen to lie 3.6 % apart in the two
+// pairs testify to nothing.
+TEST(SteadyLayerStep, APeakInsideTheGateThatTheOtherLayersRefuteIsAnotherLayer) {
+  LengthSource source = LengthSource::kNone;
+  const PairMotion step = detail::steadyLayerStep(motionAlongX(132.5), withPeaks({{92.7, 1.0}, {114.0, 0.3}, {132.5, 0.5}}),
+                                                  threeLevels01(), 110.0, EstimatorConfig(), kShiftPerBin, 1.0, &source);
+  EXPECT_NEAR(step.shift(), 110.0, 0.2);
+  EXPECT_EQ(source, LengthSource::kLayerRatio);
+  const EstimatorConfig config;
+  ASSERT_LT(config.tracking.layer_min_fraction, 0.02);
+  ASSERT_GT(config.tracking.steady_layer_min_fraction, 0.02);
+  const std::vector<float> with_wall01 = energyWithPeaks({{92.7, 1.0}, {110.0, 0.6}, {132.5, 0.5}, {160.0, 0.02}});
+  const PairMotion past_walls = detail::steadyLayerStep(
+      motionAlongX(132.5), withPeaks({{92.7, 1.0}, {114.0, 0.3}, {132.5, 0.5}, {160.0 * 114.0 / 110.0, 0.02}}),
+      with_wall01, 110.0, config, kShiftPerBin, 1.0, &source);
+  EXPECT_NEAR(past_walls.shift(), 110.0, 0.2);
+  EXPECT_EQ(source, LengthSource::kLayerRatio);
+}
+
+// The same peak where every layer moved 3.6 % further (the vehicle sped up): the other layers
+// keep its ratio, and it is the followed layer's. With a single other layer nothing refutes it.
+TEST(SteadyLayerStep, APeakTheOtherLayersKeepPaceWithStands) {
+  constexpr double kFaster = 114.0 / 110.0;
+  LengthSource source = LengthSource::kNone;
+  const PairMotion faster = detail::steadyLayerStep(
+      motionAlongX(132.5 * kFaster), withPeaks({{92.7 * kFaster, 1.0}, {114.0, 0.3}, {132.5 * kFaster, 0.5}}),
+      threeLevels01(), 110.0, EstimatorConfig(), kShiftPerBin, 1.0, &source);
+  EXPECT_NEAR(faster.shift(), 114.0, 0.2);
+  EXPECT_EQ(source, LengthSource::kEnergyPeak);
+  const PairMotion one_other = detail::steadyLayerStep(
+      motionAlongX(92.7), withPeaks({{92.7, 1.0}, {114.0, 0.3}}), energyWithPeaks({{92.7, 1.0}, {110.0, 0.6}}), 110.0,
+      EstimatorConfig(), kShiftPerBin, 1.0, &source);
+  EXPECT_NEAR(one_other.shift(), 114.0, 0.2);
+  EXPECT_EQ(source, LengthSource::kEnergyPeak);
+}
+
 // Slow motion: a steady length inside the no-motion zone (4 x skip_bins = 20 bins here), where a
 // static pattern peaks, does not hold back a speed-up.
 TEST(SteadyLayerStep, SlowMotionIsLeftAlone) {
@@ -327,6 +375,44 @@ TEST(ObserveFollowedLayer, NoChangeOfSpeedIsReadOverSkippedFrames) {
   EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
   EXPECT_NEAR(observedAfter132(predicted132(0.5, 30.0), 0.3, registration, 0.0, 0.0, &obs).shift(), 150.0, 1e-9);
   EXPECT_EQ(obs.length_source, LengthSource::kMotionChange);
+}
+
+// observe() of pair 1-2 after pair 0-1 moved the followed layer 132 px along x, with pair 0-1's
+// translation energy vector, without PMT.
+PairMotion observedAfter132With(const PairRegistration& registration, const std::vector<float>& energy01,
+                                PairObservations& obs) {
+  detail::Reference ref;
+  ref.translation = {132.0, 0.0};
+  ref.shift = 132.0;
+  ref.shift_sigma = 0.3;
+  ref.translation_energy = &energy01;
+  PairMotion measured = motionAlongX(registration.translation.x);
+  measured.log_zoom_sigma = 1e-3;
+  const RegistrationPrior prior = predicted132(0.5, 30.0);
+  PairMotion initial;
+  obs = detail::observe(registration, measured, MatchResult(), MatchResult(), ref, EstimatorConfig(), kShiftPerBin,
+                        1.0, 1.0, &prior, initial);
+  return initial;
+}
+
+// The followed tops (132 px in pair 0-1, and predicted there) have left the view; the pair's
+// highest peak is a wall's at 136.5 px, on the motion and inside layer_gate. The ground (92.7 px)
+// and the higher tops (160 px) keep their speed: the wall's peak is another layer, and the step
+// keeps the followed tops' length by the other layers' speed, along the peak's direction. Where
+// every layer moved as much further, the peak is the followed layer's.
+TEST(ObserveFollowedLayer, APeakInsideTheGateThatTheOtherLayersRefuteIsAnotherLayer) {
+  const std::vector<float> energy01 = energyWithPeaks({{92.7, 1.0}, {132.0, 0.6}, {160.0, 0.5}});
+  PairRegistration wall = withPeaks({{92.7, 0.8}, {136.5, 1.0}, {160.0, 0.5}});
+  wall.translation = {136.5, 0.0};
+  PairObservations obs;
+  EXPECT_NEAR(observedAfter132With(wall, energy01, obs).shift(), 132.0, 0.3);
+  EXPECT_EQ(obs.length_source, LengthSource::kLayerRatio);
+  EXPECT_EQ(obs.translation_use, PairObservations::TranslationUse::kDirection);
+  constexpr double kFaster = 136.5 / 132.0;
+  PairRegistration faster = withPeaks({{92.7 * kFaster, 0.8}, {136.5, 1.0}, {160.0 * kFaster, 0.5}});
+  faster.translation = {136.5, 0.0};
+  EXPECT_NEAR(observedAfter132With(faster, energy01, obs).shift(), 136.5, 1e-9);
+  EXPECT_EQ(obs.length_source, LengthSource::kPeak);
 }
 
 // A step of 108.9 px whose PMT stretch said 131.8 px (the roofs it followed before) and whose
