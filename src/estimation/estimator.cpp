@@ -121,6 +121,7 @@ struct Estimator::State {
     failed = 0;
     anchor.reset();
     last_step.reset();
+    restart_length.reset();
     forgetMotionModel();
     plane_tilt.clear();
     layer_ratios.clear();
@@ -192,6 +193,8 @@ struct Estimator::State {
   // The step at the length the layers in view vouch for (LayerRatioMemory) where its own length
   // breaks their ratios by more than tracking.layer_gate (oefmt mode).
   PairMotion vouchedStep(const PairMotion& step, Estimate& est) const;
+  // Before the first pair after a restart is integrated: its scale continued (see the definition).
+  void continueScale(const PairMotion& step, const Estimate& est);
   // A registration too weak to use on its own whose layers in view still vouch (by the ratios
   // they held) for the length the motion so far predicts: that step (oefmt mode), with
   // est.measured12 and est.vouched_length set.
@@ -273,6 +276,9 @@ struct Estimator::State {
   // failed): none where one of them came without a turn.
   std::optional<std::pair<double, double>> turn_since_f1 = std::make_pair(0.0, 0.0);
   std::optional<PairMotion> last_step;  // the last motion per frame interval
+  // The followed layer's length per frame interval [px] when tracking was lost and the window
+  // restarted, until the first pair after the restart is integrated (continueScale).
+  std::optional<double> restart_length;
   // The last accepted motions per frame interval, newest last (kept through restarts: the
   // vehicle keeps moving while frames fail); the rotation/zoom prediction's source.
   std::deque<PairMotion> recent_steps;
@@ -478,6 +484,7 @@ void Estimator::State::registrationFailed(WindowFrame&& frame, bool textured, Es
   }
   if (failed <= config.tracking.max_failed_frames) return;
   // Too long without a registration: restart from this frame, continuing from this pose.
+  if (last_step && config.mode == EstimatorMode::kOefmt) restart_length = last_step->shift();
   startWindowOver();
   anchor.reset();
   last_step.reset();
@@ -828,6 +835,23 @@ PairMotion Estimator::State::vouchedStep(const PairMotion& step, Estimate& est) 
   return atVouchedLength(step, *vouched);
 }
 
+void Estimator::State::continueScale(const PairMotion& step, const Estimate& est) {
+  // A restart follows its first pair's highest peak, and a pair has no scale of its own: where
+  // that peak is another depth layer than the one followed before (the ground instead of the
+  // roofs), every later step kept the two layers' depth ratio as a wrong scale. The vehicle kept
+  // its speed over the few frames that failed (their poses were predicted so): the new layer is
+  // taken at the depth that gives the pair the length per interval the followed layer had, where
+  // the two lengths differ by no more than two depth layers' shifts can (kMaxDepthLayerRatio;
+  // further apart, the peak is an alias or the speed did change).
+  const std::optional<double> before = restart_length;
+  restart_length.reset();
+  const double length = step.shift();
+  if (!before || !(*before > 0.0) || !(length > 0.0) || have01) return;
+  const double depth_ratio = *before * est.frame_gap / length;
+  if (depth_ratio > kMaxDepthLayerRatio || depth_ratio < 1.0 / kMaxDepthLayerRatio) return;
+  integrator.moveReferencePlane(depth_ratio);
+}
+
 std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) const {
   // Where one depth layer fills most of the view, its texture (oriented, periodic) can leave the
   // translation peak too flat to trust on its own, while the layers in its energy vector still
@@ -1103,6 +1127,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       if (config_.mode == EstimatorMode::kOefmt) {
         step = s.consistentRates(s.plausibleStep(s.vouchedStep(step, est), est), rates_rotation12,
                                 gyro_turn12, est);
+        s.continueScale(step, est);
       }
       s.advance(std::move(frame), step, std::move(next_translation01), est);
     }

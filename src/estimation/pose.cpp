@@ -55,7 +55,13 @@ PoseIntegrator::PoseIntegrator(double initial_altitude, double fx)
 void PoseIntegrator::reset(double stamp) {
   pose_ = Pose4{};
   pose_.stamp = stamp;
+  plane_height_ = 0.0;
   last_step_covariance_ = cv::Matx44d::zeros();
+}
+
+void PoseIntegrator::moveReferencePlane(double depth_ratio) {
+  if (!std::isfinite(depth_ratio) || !(depth_ratio > 0.0)) return;
+  plane_height_ += altitude() * (1.0 - depth_ratio);
 }
 
 void PoseIntegrator::correctAltitude(double altitude, double variance) {
@@ -76,7 +82,7 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
   using Vec2 = Eigen::Vector2d;
   const double psi = wrapToPi(-pose_.yaw + step.rotation);
   const double inv_zoom = std::exp(-step.log_zoom);
-  const double altitude = (initial_altitude_ + pose_.z) * inv_zoom;
+  const double altitude = this->altitude() * inv_zoom;
   const double metres_per_px = altitude / fx_;
   const double c = std::cos(psi), s = std::sin(psi);
   Eigen::Matrix2d rotation;
@@ -115,7 +121,7 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
   const Vec2 world_step = flip * image_step;
   pose_.x += world_step.x();
   pose_.y += world_step.y();
-  pose_.z = altitude - initial_altitude_;
+  pose_.z = altitude + plane_height_ - initial_altitude_;
   pose_.yaw = wrapToPi(-psi);
   pose_.stamp = stamp;
   for (int r = 0; r < 4; ++r) {
@@ -130,6 +136,7 @@ const Pose4& PoseIntegrator::integrate(const PairMotion& step, double stamp) {
 void PoseIntegrator::rescale(double factor) {
   if (!std::isfinite(factor) || !(factor > 0.0)) return;
   initial_altitude_ *= factor;
+  plane_height_ *= factor;
   pose_ = rescaled(pose_, factor);
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) {

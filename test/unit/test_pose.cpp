@@ -65,6 +65,26 @@ TEST(PoseIntegrator, ShrinkingContentMeansClimbing) {
   EXPECT_NEAR(integrator.integrate(step(0.0, 1.0, {-10.0, 0.0}), 2.0).x, 10.0 * 110.0 / kFx, 1e-9);
 }
 
+// A restart whose first pair reads roofs at 80 % of the ground's depth: the pose stays where it
+// is, the next steps' pixels cover 80 % as much ground, and a climb changes the roofs' depth by
+// the same metres as the camera's height.
+TEST(PoseIntegrator, AnotherReferencePlaneKeepsThePoseAndScalesTheSteps) {
+  PoseIntegrator integrator(kAltitude, kFx);
+  integrator.reset(0.0);
+  integrator.integrate(step(0.0, 1.0, {-10.0, 0.0}), 1.0);
+  const Pose4 before = integrator.pose();
+  integrator.moveReferencePlane(0.8);
+  EXPECT_DOUBLE_EQ(integrator.pose().x, before.x);
+  EXPECT_DOUBLE_EQ(integrator.pose().z, before.z);
+  EXPECT_NEAR(integrator.altitude(), 80.0, 1e-9);
+  EXPECT_NEAR(integrator.integrate(step(0.0, 1.0, {-10.0, 0.0}), 2.0).x - before.x, 10.0 * 80.0 / kFx, 1e-9);
+  const Pose4& climbed = integrator.integrate(step(0.0, 80.0 / 88.0, {0.0, 0.0}), 3.0);
+  EXPECT_NEAR(climbed.z, 8.0, 1e-9);  // the camera's height, not the roofs' depth
+  EXPECT_NEAR(integrator.altitude(), 88.0, 1e-9);
+  integrator.reset(4.0);
+  EXPECT_NEAR(integrator.altitude(), kAltitude, 1e-9);  // a reset goes back to the first plane
+}
+
 TEST(PoseIntegrator, ShiftsAreTurnedByTheHeading) {
   PoseIntegrator integrator(kAltitude, kFx);
   integrator.reset(0.0);

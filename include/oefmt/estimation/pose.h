@@ -49,7 +49,8 @@ std::array<double, 4> yawQuaternion(double yaw);
 ///   psi_k = wrap(psi_{k-1} + theta),  Z_k = Z_{k-1} / s,
 ///   step  = -(Z_k / fx) R(psi_k) d   in first-image axes (y down): the camera moves opposite to
 ///   the content, by the content shift scaled from pixels at altitude Z_k to world units;
-/// the step's y is flipped into the world's y (north = up in the image), z = Z_k - Z_0.
+/// the step's y is flipped into the world's y (north = up in the image), z = Z_k - Z_0 (plus the
+/// height of a reference plane moveReferencePlane() moved: z stays the camera's height).
 class PoseIntegrator {
  public:
   /// initial_altitude: Z_0 above the dominant plane in output units (the altitude in metres, or 1
@@ -72,19 +73,27 @@ class PoseIntegrator {
   /// `factor` (> 0), their covariance times its square, as if the flight had started at
   /// factor times the initial altitude (every step's metres per pixel scale alike).
   void rescale(double factor);
+  /// The steps from here follow another plane, `depth_ratio` (> 0) times as deep below the camera
+  /// as the current reference plane (a restart whose first pair read another depth layer): the
+  /// pose stays, and the next steps' metres per pixel and altitude change scale with the new
+  /// plane's depth.
+  void moveReferencePlane(double depth_ratio);
   /// The covariance the last integrate() or hold() added to the pose (x, y, z, yaw): the
   /// uncertainty of that one step alone, in the world frame and output units.
   const cv::Matx44d& lastStepCovariance() const { return last_step_covariance_; }
 
   const Pose4& pose() const { return pose_; }
   /// Z_k: current altitude above the reference plane (output units).
-  double altitude() const { return initial_altitude_ + pose_.z; }
+  double altitude() const { return initial_altitude_ + pose_.z - plane_height_; }
   double initialAltitude() const { return initial_altitude_; }
   double fx() const { return fx_; }
 
  private:
   double initial_altitude_;
   double fx_;
+  // How far the reference plane lies above the first frame's (output units): z stays the
+  // camera's height when moveReferencePlane() changes the plane.
+  double plane_height_ = 0.0;
   Pose4 pose_;
   cv::Matx44d last_step_covariance_ = cv::Matx44d::zeros();
 };
