@@ -31,16 +31,32 @@ PairMotion atLayerLength(const PairMotion& step, double length) {
                     std::max(across * length / step.shift(), kMinShiftSigma));
 }
 
+// The speed ratio of the depth layer at `bin` of pair 1-2: its shift over the interval against
+// the pair 0-1 peak (`peaks01`) nearest to steady speed, within tracking.layer_gate of it; none
+// where no peak of pair 0-1 lies that close.
+std::optional<double> steadySpeedRatio(double bin, const std::vector<EnergyPeak>& peaks01, double intervals,
+                                       double layer_gate) {
+  std::optional<double> nearest;
+  for (const EnergyPeak& q : peaks01) {
+    if (!(q.bin > 0.0)) continue;
+    const double r = bin / intervals / q.bin;
+    if (std::fabs(r - 1.0) <= layer_gate && (!nearest || std::fabs(r - 1.0) < std::fabs(*nearest - 1.0))) {
+      nearest = r;
+    }
+  }
+  return nearest;
+}
+
 // Speed ratios of a rigid scene: a change of the vehicle's speed changes every depth layer's
 // shift by the same ratio (a climb's zoom adds a little more for the nearer layers). A candidate
 // for the followed layer's length, at `candidate_ratio` of the steady length, is another layer (a
 // wall, a neighbouring top a few per cent nearer) where at least two other layers seen in both
 // pairs (a translation energy peak of pair 1-2 with one of pair 0-1 within tracking.layer_gate of
 // it over the frame intervals, both reaching tracking.steady_layer_min_fraction) agree on another
-// ratio and none keeps the candidate's. Where walls
-// fill the energy vectors with peaks between the layers, one of them inside the gate was taken
-// for the followed layer at each pair, and the length walked from one to the next. Returns the
-// ratio the other layers agree on, or nothing where the candidate may be the followed layer.
+// ratio and none keeps the candidate's. Where walls fill the energy vectors with peaks between
+// the layers, one of them inside the gate was taken for the followed layer at each pair, and the
+// length walked from one to the next. Returns the ratio the other layers agree on, or nothing
+// where the candidate may be the followed layer.
 std::optional<double> contradictingSpeedRatio(const std::vector<float>& energy12, const std::vector<float>& energy01,
                                               double candidate_bin, double candidate_ratio, double intervals,
                                               double log_zoom, const TrackingConfig& tracking) {
@@ -52,16 +68,14 @@ std::optional<double> contradictingSpeedRatio(const std::vector<float>& energy12
   std::vector<double> ratios;  // per other layer of pair 1-2: its speed ratio nearest to steady speed
   for (const EnergyPeak& p : energyPeaks(energy12, tracking.steady_layer_min_fraction)) {
     if (std::fabs(p.bin - candidate_bin) <= 1.0) continue;  // the candidate's own peak
-    std::optional<double> nearest;
     for (const EnergyPeak& q : peaks01) {
-      if (!(q.bin > 0.0)) continue;
-      const double r = p.bin / intervals / q.bin;
-      if (std::fabs(r - candidate_ratio) <= tolerance) return std::nullopt;  // a layer keeps its ratio
-      if (std::fabs(r - 1.0) <= tracking.layer_gate && (!nearest || std::fabs(r - 1.0) < std::fabs(*nearest - 1.0))) {
-        nearest = r;
+      if (q.bin > 0.0 && std::fabs(p.bin / intervals / q.bin - candidate_ratio) <= tolerance) {
+        return std::nullopt;  // a layer keeps the candidate's ratio
       }
     }
-    if (nearest) ratios.push_back(*nearest);
+    if (const std::optional<double> r = steadySpeedRatio(p.bin, peaks01, intervals, tracking.layer_gate)) {
+      ratios.push_back(*r);
+    }
   }
   // The largest group of ratios within the tolerance of each other, its median.
   std::sort(ratios.begin(), ratios.end());
@@ -139,8 +153,10 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
                                    cv::norm(d) / length, intervals, prior.log_zoom, config.tracking);
   };
   const auto followed = [&](const cv::Point2d& d) { return inGate(d) && !refutingRatio(d); };
+  const bool measured_in_gate = inGate(measured.translation);
+  const std::optional<double> refuted = measured_in_gate ? refutingRatio(measured.translation) : std::nullopt;
   obs.length_source = LengthSource::kPeak;
-  if (followed(measured.translation)) return;  // the correlation peak is the layer's
+  if (measured_in_gate && !refuted) return;  // the correlation peak is the layer's
   if (registration.followed_confidence >= config.registration.min_confidence &&
       followed(registration.followed_translation)) {
     // Another layer's peak is the highest; the followed one stands out where it was predicted.
@@ -183,8 +199,6 @@ void observeFollowedLayer(const PairRegistration& registration, const PairMotion
   const bool speed_change_in_reach = on_direction && !skipped_frames &&
                                      cv::norm(measured.translation - predicted) <= prior.translation_radius;
   LengthSource layered_source = LengthSource::kPrediction;
-  const std::optional<double> refuted =
-      inGate(measured.translation) ? refutingRatio(measured.translation) : std::nullopt;
   // The layers' speeds are compared at the predicted zoom: a pair whose highest peak is another
   // layer's or a wall's may have misread its zoom as well.
   PairMotion at_predicted_zoom = measured;
@@ -511,15 +525,8 @@ PairMotion steadyLayerStep(const PairMotion& candidate, const PairRegistration& 
     // median or the highest layer's.
     const std::vector<EnergyPeak> peaks01 = energyPeaks(translation01, tracking.layer_min_fraction);
     for (const EnergyPeak& p : energyPeaks(registration12.translation_energy, min_fraction)) {
-      const double expected = p.bin / intervals;  // where pair 0-1 saw this layer
-      for (const EnergyPeak& q : peaks01) {
-        if (!(q.bin > 0.0)) continue;
-        const double r = expected / q.bin;
-        if (std::fabs(r - 1.0) <= tracking.layer_gate &&
-            (!(ratio > 0.0) || std::fabs(r - 1.0) < std::fabs(ratio - 1.0))) {
-          ratio = r;
-        }
-      }
+      const std::optional<double> r = steadySpeedRatio(p.bin, peaks01, intervals, tracking.layer_gate);
+      if (r && (!(ratio > 0.0) || std::fabs(*r - 1.0) < std::fabs(ratio - 1.0))) ratio = *r;
     }
   }
   if (!(ratio > 0.0)) return candidate;

@@ -73,6 +73,10 @@ TEST(PoseIntegrator, AnotherReferencePlaneKeepsThePoseAndScalesTheSteps) {
   integrator.reset(0.0);
   integrator.integrate(step(0.0, 1.0, {-10.0, 0.0}), 1.0);
   const Pose4 before = integrator.pose();
+  for (const double unusable : {0.0, -0.8, std::nan("")}) {
+    integrator.moveReferencePlane(unusable);  // ignored: no plane lies there
+    EXPECT_DOUBLE_EQ(integrator.altitude(), kAltitude) << unusable;
+  }
   integrator.moveReferencePlane(0.8);
   EXPECT_DOUBLE_EQ(integrator.pose().x, before.x);
   EXPECT_DOUBLE_EQ(integrator.pose().z, before.z);
