@@ -1134,6 +1134,9 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     s.turn_since_f1 = turn12;  // unless this frame became frame 1 (below), the next pair spans it
   }
   if (!s.f1 || s.f1->index == est.frame_index) s.turn_since_f1 = std::make_pair(0.0, 0.0);
+  // A kept frame is only ever the older one of a pair from now on: its correlations as the
+  // newer one (computed ahead, FrameSpectra::correlated) are of no more use.
+  if (s.f1) s.f1->spectra.correlated.clear();
   est.pose = s.integrator.pose();
   if (est.state != TrackingState::kStarted) est.step_covariance = s.integrator.lastStepCovariance();
   est.total_ms = prepare_ms + msSince(start);

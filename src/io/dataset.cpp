@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "oefmt/io/dataset.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -316,6 +319,14 @@ const std::string& FolderDataset::imagePath(std::size_t index) const {
 double FolderDataset::timestamp(std::size_t index) const {
   checkIndex(index);
   return has_timestamps_ ? timestamps_[index] : static_cast<double>(index);
+}
+
+void FolderDataset::adviseReading(std::size_t index) const {
+  if (index >= paths_.size()) return;
+  const int fd = ::open(paths_[index].c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  (void)::posix_fadvise(fd, 0, 0, POSIX_FADV_WILLNEED);
+  ::close(fd);
 }
 
 cv::Mat FolderDataset::loadImage(std::size_t index) const {

@@ -431,15 +431,28 @@ void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& n
 }
 
 void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer) {
-  centredCrossPower(newer.log_polar_spectrum, older.log_polar_spectrum, rotation_zoom_power_);
+  // Computed ahead where the builder of both frames did (SpectraBuilder::setLookback): copied,
+  // since the candidates clear the surface around the peaks they tried.
+  for (const RotationZoomCorrelation& ahead : newer.correlated) {
+    if (older.serial == 0 || ahead.older_serial != older.serial) continue;
+    ahead.power.copyTo(rotation_zoom_power_);
+    rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
+    rotation_zoom_highest_ = ahead.highest;
+    rotation_zoom_stats_ = ahead.stats;
+    return;
+  }
   // The full surface: a coarse low-resolution search for the rotation row (to invert only a
   // band of rows) picked wrong rows on simulated flights, where much of the log-polar
   // correlation's energy sits at high frequencies. In place: the surface is a view of
   // rotation_zoom_power_ (its own buffer, so that the translation leaves it for the next
   // candidate).
-  context_->fft().inverseInPlace(rotation_zoom_power_);
+  RotationZoomCorrelation here;
+  here.power = rotation_zoom_power_;
+  oefmt::correlateRotationZoom(*context_, newer.log_polar_spectrum, older.log_polar_spectrum, here);
+  rotation_zoom_power_ = here.power;
   rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
-  rotation_zoom_highest_ = findPeak(rotation_zoom_surface_, true, &rotation_zoom_stats_, PeakShape::kBroadened);
+  rotation_zoom_highest_ = here.highest;
+  rotation_zoom_stats_ = here.stats;
 }
 
 double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistration& result,

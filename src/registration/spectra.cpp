@@ -2,6 +2,7 @@
 #include "oefmt/registration/spectra.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -229,7 +230,37 @@ FrameSpectra SpectraBuilder::build(const PreparedImage& image) {
   cv::Mat1f log_polar = fft.inPlaceInput(frame.log_polar_spectrum);
   context_->logPolar(magnitude_, log_polar);
   fft.forwardInPlace(frame.log_polar_spectrum);
+  static std::atomic<std::uint64_t> next_serial{1};
+  frame.serial = next_serial.fetch_add(1);
+  if (lookback_ > 0) {
+    // One more than the lookback: the frame built last is among them.
+    recent_.push_back({frame.serial, frame.log_polar_spectrum});
+    if (static_cast<int>(recent_.size()) > lookback_ + 1) recent_.erase(recent_.begin());
+  }
   return frame;
+}
+
+void SpectraBuilder::setLookback(int frames) {
+  lookback_ = std::max(frames, 0);
+  const std::size_t keep = lookback_ > 0 ? static_cast<std::size_t>(lookback_) + 1 : 0;
+  while (recent_.size() > keep) recent_.erase(recent_.begin());
+}
+
+void SpectraBuilder::correlateWithRecent(FrameSpectra& frame) const {
+  if (recent_.empty() || recent_.back().serial != frame.serial) return;  // not the frame built last
+  for (std::size_t i = 0; i + 1 < recent_.size(); ++i) {
+    RotationZoomCorrelation c;
+    c.older_serial = recent_[i].serial;
+    correlateRotationZoom(*context_, frame.log_polar_spectrum, recent_[i].log_polar_spectrum, c);
+    frame.correlated.push_back(std::move(c));
+  }
+}
+
+void correlateRotationZoom(const SpectralContext& context, const cv::Mat2f& newer, const cv::Mat2f& older,
+                           RotationZoomCorrelation& out) {
+  centredCrossPower(newer, older, out.power);
+  context.fft().inverseInPlace(out.power);
+  out.highest = findPeak(context.fft().realView(out.power), true, &out.stats, PeakShape::kBroadened);
 }
 
 FrameSpectra SpectraBuilder::build(const cv::Mat& image, ChannelOrder order) {

@@ -13,6 +13,9 @@
 namespace oefmt {
 namespace {
 
+// How many frames ahead a folder's images are read in the background.
+constexpr std::size_t kReadAhead = 4;
+
 class FolderSource : public FrameSource {
  public:
   explicit FolderSource(const std::string& directory) : dataset_(directory) {}
@@ -24,6 +27,12 @@ class FolderSource : public FrameSource {
     // (as the authors' ground truth is indexed).
     frame.stamp = dataset_.timestamp(index_);
     frame.name = dataset_.imageName(index_);
+    // The files a few frames ahead are read in the background meanwhile: where they are not in
+    // the page cache yet (a flight's first run), the reader would otherwise wait for the disk at
+    // every frame.
+    for (std::size_t ahead = index_ == 0 ? 1 : kReadAhead; ahead <= kReadAhead; ++ahead) {
+      dataset_.adviseReading(index_ + ahead);
+    }
     frame.image = dataset_.loadImage(index_);
     ++index_;
     return true;
@@ -53,8 +62,11 @@ std::unique_ptr<FrameSource> openFolder(const std::string& directory) {
 }
 
 PrefetchingSource::PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth,
-                                     Analyse analyse)
-    : source_(std::move(source)), depth_(depth == 0 ? 1 : depth), analyse_(std::move(analyse)) {
+                                     Analyse analyse, Analyse spare)
+    : source_(std::move(source)),
+      depth_(depth == 0 ? 1 : depth),
+      analyse_(std::move(analyse)),
+      spare_(std::move(spare)) {
   thread_ = std::thread(&PrefetchingSource::run, this);
 }
 
@@ -78,6 +90,7 @@ void PrefetchingSource::run() {
       if (more && analyse_) {
         try {
           analyse_(frame);
+          if (spare_ && consumerHasWork()) spare_(frame);
         } catch (const InputError& e) {
           throw InputError(frame.name + ": " + e.what());  // which frame, for the user
         }
@@ -98,6 +111,11 @@ void PrefetchingSource::run() {
     queue_.push_back(std::move(frame));
     changed_.notify_all();
   }
+}
+
+bool PrefetchingSource::consumerHasWork() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return !queue_.empty();
 }
 
 bool PrefetchingSource::next(SourceFrame& frame) {

@@ -60,12 +60,14 @@ std::unique_ptr<FrameSource> openBag(const std::string& path, const std::string&
 
 /// Reads ahead from a source on its own thread, at most `depth` frames. With `analyse`, each
 /// frame's spectra are made on that thread too (`analyse` sets frame.spectra, and frame.tilt when
-/// it levels the frame; the decoded image is released after it).
+/// it levels the frame; the decoded image is released after it). `spare` runs after `analyse`
+/// only while the consumer still has a frame queued, so that it does not wait for this one:
+/// work the consumer would otherwise do itself, taken over only when the reader is ahead.
 class PrefetchingSource {
  public:
   using Analyse = std::function<void(SourceFrame& frame)>;
   PrefetchingSource(std::unique_ptr<FrameSource> source, std::size_t depth = 4,
-                    Analyse analyse = nullptr);
+                    Analyse analyse = nullptr, Analyse spare = nullptr);
   ~PrefetchingSource();
   PrefetchingSource(const PrefetchingSource&) = delete;
   PrefetchingSource& operator=(const PrefetchingSource&) = delete;
@@ -76,10 +78,12 @@ class PrefetchingSource {
 
  private:
   void run();
+  bool consumerHasWork();
 
   std::unique_ptr<FrameSource> source_;
   std::size_t depth_;
   Analyse analyse_;
+  Analyse spare_;
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<SourceFrame> queue_;

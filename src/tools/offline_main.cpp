@@ -135,6 +135,9 @@ oefmt::FrameSpectra cloneSpectra(const oefmt::FrameSpectra& s) {
   return copy;
 }
 
+// How many pairs each frame is registered in as the newer one: 1-2, and 0-2 in oefmt mode.
+int pairsPerFrame(oefmt::EstimatorMode mode) { return mode == oefmt::EstimatorMode::kOefmt ? 2 : 1; }
+
 // A reading belongs to a frame within this of its stamp [s].
 constexpr double kRangeMatch = 0.02;
 
@@ -304,20 +307,26 @@ int main(int argc, char** argv) {
       if (!notice.empty()) std::fprintf(stderr, "oefmt_offline: %s\n", notice.c_str());
     }
     const auto context = std::make_shared<const oefmt::SpectralContext>(config.modeRegistration());
+    // While this thread still has a frame queued, the reader also correlates each frame's
+    // log-polar spectrum with the frames its pairs will register it against (1-2, and 0-2 in
+    // oefmt mode): the registrations' first step, moved off their threads when the reader is
+    // ahead of them (doc/performance.md).
+    const auto builder = std::make_shared<oefmt::SpectraBuilder>(context);
+    builder->setLookback(pairsPerFrame(config.mode));
     oefmt::PrefetchingSource source(
         std::move(opened), 2,
-        [builder = oefmt::SpectraBuilder(context), undistorter, attitudes, nadir, camera_in_imu,
-         unlevelled](oefmt::SourceFrame& frame) mutable {
+        [builder, undistorter, attitudes, nadir, camera_in_imu, unlevelled](oefmt::SourceFrame& frame) {
           if (attitudes) {
             frame.tilt = oefmt::cameraTiltAt(*attitudes, frame.stamp, camera_in_imu);
             if (frame.tilt) {
-              frame.spectra = builder.build(nadir->prepare(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
+              frame.spectra = builder->build(nadir->prepare(frame.image, oefmt::nadirFromOptical(*frame.tilt)));
               return;
             }
             ++*unlevelled;  // no attitude at this stamp: the frame is taken as level
           }
-          frame.spectra = builder.build(undistorter ? undistorter->apply(frame.image) : frame.image);
-        });
+          frame.spectra = builder->build(undistorter ? undistorter->apply(frame.image) : frame.image);
+        },
+        [builder](oefmt::SourceFrame& frame) { builder->correlateWithRecent(frame.spectra); });
 
     trajectory.open(options.output);
     if (!trajectory) throw oefmt::InputError("cannot write '" + options.output + "'");

@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "frame_source.h"
 #include "oefmt/error.h"
@@ -65,6 +67,39 @@ TEST(PrefetchingSource, DeliversEveryFrameInOrderWithItsOwnSpectra) {
   }
   EXPECT_EQ(count, 50u);
   EXPECT_FALSE(source.next(frame));  // and stays at the end
+}
+
+// The spare work (marked as the frame's mean) runs only where the consumer still has a frame
+// queued when the frame is analysed: never while it waits for each frame in turn, and on every
+// frame but the first when the reader runs ahead of a consumer that has not started yet.
+PrefetchingSource::Analyse markingSpareWork() {
+  return [](SourceFrame& frame) { frame.spectra.mean = 1.0f; };
+}
+
+TEST(PrefetchingSource, SpareWorkRunsOnlyWhileTheConsumerHasAFrameQueued) {
+  {
+    PrefetchingSource source(std::make_unique<CountingSource>(5, kNever, nullptr), 8, recordingAnalysis(),
+                             markingSpareWork());
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the reader reads all five
+    SourceFrame frame;
+    for (std::size_t k = 0; k < 5; ++k) {
+      ASSERT_TRUE(source.next(frame));
+      EXPECT_EQ(frame.spectra.mean, k == 0 ? 0.0f : 1.0f) << k;
+    }
+  }
+  {
+    const PrefetchingSource::Analyse record = recordingAnalysis();
+    const auto slow = [record](SourceFrame& frame) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      record(frame);
+    };
+    PrefetchingSource source(std::make_unique<CountingSource>(4, kNever, nullptr), 8, slow, markingSpareWork());
+    SourceFrame frame;
+    for (std::size_t k = 0; k < 4; ++k) {
+      ASSERT_TRUE(source.next(frame));  // waits for each: the queue is empty when the next is made
+      EXPECT_EQ(frame.spectra.mean, 0.0f) << k;
+    }
+  }
 }
 
 TEST(PrefetchingSource, WithoutAnalysisDeliversTheImages) {

@@ -135,6 +135,10 @@ TEST(Dataset, ClearErrorsForMissingOrBrokenFiles) {
   writeText((dir.path() / "Images" / "0003.png").string(), "not a png");
   const FolderDataset dataset(dir.path().string());
   expectDatasetError([&] { dataset.loadImage(1); }, "0002.png' does not exist");
+  // Reading ahead is only advice: a missing file or an index past the end says nothing (loading
+  // it does).
+  EXPECT_NO_THROW(dataset.adviseReading(1));
+  EXPECT_NO_THROW(dataset.adviseReading(99));
   expectDatasetError([&] { dataset.loadImage(2); }, "cannot read image");
   EXPECT_THROW(dataset.loadImage(3), InputError);
 

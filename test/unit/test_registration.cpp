@@ -6,12 +6,15 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/registration/registration.h"
+#include "oefmt/registration/spectra.h"
 #include "oefmt/sim/flight.h"
 #include "oefmt/sim/renderer.h"
 #include "oefmt/sim/texture.h"
@@ -219,6 +222,57 @@ TEST(Registration, CombinedWarpGivesShiftInNewerAxes) {
   EXPECT_NEAR(r.zoom, 1.08, 0.002);
   EXPECT_NEAR(r.translation.x, 7.5, 0.2);
   EXPECT_NEAR(r.translation.y, -4.25, 0.2);
+}
+
+// A reader thread's builder correlates each frame with the ones before it
+// (SpectraBuilder::correlateWithRecent); the Registrar takes those surfaces instead of computing them,
+// and must register exactly as it would have.
+TEST(Registration, RotationZoomCorrelatedAheadRegistersExactlyAsComputedHere) {
+  sim::ViewMotion first, second;
+  first.rotation = rad(6.0);
+  first.zoom = 1.05;
+  first.shift = {9.0, -3.5};
+  second.rotation = rad(-11.0);
+  second.zoom = 0.96;
+  second.shift = {-14.0, 6.0};
+  const auto a = test::warpedPair(first), b = test::warpedPair(second);
+  const cv::Mat unrelated = test::warpedPair(second, kN, 11).newer;  // another texture
+  const cv::Mat images[4] = {a.older, a.newer, b.newer, unrelated};
+  const auto context = test::sharedContext(kN);
+  SpectraBuilder ahead(context), plain(context);
+  ahead.setLookback(2);
+  std::vector<FrameSpectra> with, without;
+  for (const cv::Mat& image : images) {
+    with.push_back(ahead.build(image));
+    ahead.correlateWithRecent(with.back());
+    without.push_back(plain.build(image));
+  }
+  ASSERT_EQ(with[2].correlated.size(), 2u);
+  EXPECT_EQ(with[2].correlated[0].older_serial, with[0].serial);
+  EXPECT_EQ(with[2].correlated[1].older_serial, with[1].serial);
+  EXPECT_TRUE(without[2].correlated.empty());
+  Registrar registrar(context);
+  const auto same = [](const PairRegistration& x, const PairRegistration& y) {
+    return x.status == y.status && x.rotation == y.rotation && x.zoom == y.zoom &&
+           x.translation == y.translation && x.peak_confidence == y.peak_confidence &&
+           x.rotation_zoom_candidate == y.rotation_zoom_candidate && x.zoom_energy == y.zoom_energy &&
+           x.translation_energy == y.translation_energy;
+  };
+  // Twice each: a pair whose first rotation/zoom candidate does not register (the unrelated
+  // frame) tries the next ones, clearing the surface around those tried, which must not reach
+  // the frame's own copy.
+  for (const auto& [older, newer] : {std::pair{0, 2}, std::pair{1, 2}, std::pair{0, 1}, std::pair{2, 3}}) {
+    const PairRegistration computed = registrar.registerPair(without[older], without[newer]);
+    for (int run = 0; run < 2; ++run) {
+      const PairRegistration taken = registrar.registerPair(with[older], with[newer]);
+      EXPECT_TRUE(same(taken, computed)) << older << "-" << newer << " run " << run;
+    }
+    EXPECT_EQ(computed.status == RegistrationStatus::kOk, newer != 3) << older << "-" << newer;
+  }
+  // A frame the builder did not see (another builder's) is correlated here.
+  const PairRegistration foreign = registrar.registerPair(without[0], with[2]);
+  EXPECT_TRUE(same(foreign, registrar.registerPair(without[0], without[2])));
+  EXPECT_NEAR(deg(foreign.rotation), -11.0, 0.05);
 }
 
 TEST(Registration, ClassicMethodFindsTheSingleDominantMotion) {

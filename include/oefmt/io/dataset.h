@@ -103,6 +103,10 @@ class FolderDataset {
   /// The image as stored (cv::IMREAD_UNCHANGED: 8/16-bit, grey/BGR/BGRA). Throws DatasetError
   /// naming the path when it is missing, unreadable, or not of the first image's size.
   cv::Mat loadImage(std::size_t index) const;
+  /// Tells the operating system that image `index` will be read soon, so that it reads the file
+  /// in the background (POSIX_FADV_WILLNEED). Only advice: nothing happens past the last image or
+  /// where the file cannot be opened (loadImage says so when it is read).
+  void adviseReading(std::size_t index) const;
   /// Size of the images (of the first one).
   cv::Size imageSize() const { return image_size_; }
   /// Intrinsics of the images as stored (already scaled from cam_param.yaml's camera).

@@ -3,6 +3,7 @@
 // reused by every pair the frame takes part in).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "oefmt/registration/registration_config.h"
 #include "oefmt/registration/fft.h"
+#include "oefmt/registration/phase_correlation.h"
 #include "oefmt/registration/similarity_refinement.h"
 #include "oefmt/registration/image_prep.h"
 #include "oefmt/registration/simd_kernel_choice.h"
@@ -64,6 +66,15 @@ class SpectralContext {
 };
 
 /// What the registration needs of one frame; computed once when the frame arrives.
+/// The rotation/zoom correlation surface of a frame with an older one (Registrar's first step),
+/// computed ahead by the SpectraBuilder that built both.
+struct RotationZoomCorrelation {
+  std::uint64_t older_serial = 0;  ///< FrameSpectra::serial of the older frame
+  cv::Mat2f power;                 ///< the inverse FFT in place: realView(power) is the surface
+  SurfacePeak highest;             ///< findPeak(surface, cyclic columns, broadened)
+  SurfaceStats stats;              ///< of the whole surface
+};
+
 struct FrameSpectra {
   cv::Mat1f grey;               ///< N x N prepared image (not apodized), warped when it is the older
   cv::Mat2f spectrum;           ///< FFT of the apodized grey image
@@ -73,6 +84,10 @@ struct FrameSpectra {
   int invalid_pixels = 0;       ///< non-finite input pixels that were replaced
   float noise_power = 0.0f;     ///< noisePower(spectrum) (0 without noise weighting)
   RefinementImage refinement;   ///< smoothed grey for the zoom refinement (empty without it)
+  /// Unique in the process (0: none): what a RotationZoomCorrelation names its older frame by.
+  std::uint64_t serial = 0;
+  /// Correlations with the frames built just before this one (SpectraBuilder::setLookback).
+  std::vector<RotationZoomCorrelation> correlated;
 
   bool empty() const { return grey.empty(); }
 };
@@ -89,10 +104,29 @@ class SpectraBuilder {
 
   const SpectralContext& context() const { return *context_; }
 
+  /// Remember the last `frames` frames built (0: none), for correlateWithRecent.
+  void setLookback(int frames);
+  /// Adds to `frame` (the one built last) its rotation/zoom correlations with the remembered
+  /// frames built before it, which a Registrar then takes instead of computing them: where the
+  /// frames are built on a thread of their own, ahead of the registrations, that moves the
+  /// correlations off the registrations' threads.
+  void correlateWithRecent(FrameSpectra& frame) const;
+
  private:
   std::shared_ptr<const SpectralContext> context_;
   cv::Mat1f magnitude_;
+  int lookback_ = 0;
+  struct Remembered {
+    std::uint64_t serial;
+    cv::Mat2f log_polar_spectrum;  // shared, never written after build
+  };
+  std::vector<Remembered> recent_;  // oldest first; the last one is the frame built last
 };
+
+/// The rotation/zoom correlation of two frames' log-polar spectra: the surface (in place in
+/// out.power), its highest peak and sums.
+void correlateRotationZoom(const SpectralContext& context, const cv::Mat2f& newer, const cv::Mat2f& older,
+                           RotationZoomCorrelation& out);
 
 /// What to tell a user before a SpectralContext(config) measures FFT plans that the wisdom does
 /// not hold yet: which plans, about how long, and where they are kept. Empty when the wisdom
