@@ -435,6 +435,10 @@ void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpec
   // since the candidates clear the surface around the peaks they tried.
   for (const RotationZoomCorrelation& ahead : newer.correlated) {
     if (older.serial == 0 || ahead.older_serial != older.serial) continue;
+    const Fft2d& fft = context_->fft();
+    if (ahead.power.rows != fft.size() || ahead.power.cols != fft.spectrumCols() || !ahead.power.isContinuous()) {
+      break;  // not of this context's transforms (a caller's own FrameSpectra): computed here
+    }
     ahead.power.copyTo(rotation_zoom_power_);
     rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
     rotation_zoom_highest_ = ahead.highest;

@@ -273,6 +273,10 @@ TEST(Registration, RotationZoomCorrelatedAheadRegistersExactlyAsComputedHere) {
   const PairRegistration foreign = registrar.registerPair(without[0], with[2]);
   EXPECT_TRUE(same(foreign, registrar.registerPair(without[0], without[2])));
   EXPECT_NEAR(deg(foreign.rotation), -11.0, 0.05);
+  // A surface of another size (a caller's own FrameSpectra) is not taken.
+  FrameSpectra tampered = with[2];
+  tampered.correlated[1].power = cv::Mat2f(8, 8, cv::Vec2f(1.0f, 0.0f));
+  EXPECT_TRUE(same(registrar.registerPair(with[1], tampered), registrar.registerPair(without[1], without[2])));
 }
 
 TEST(Registration, ClassicMethodFindsTheSingleDominantMotion) {
