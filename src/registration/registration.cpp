@@ -431,8 +431,8 @@ void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& n
 }
 
 void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer) {
-  // Computed ahead where the builder of both frames did (SpectraBuilder::setLookback): copied,
-  // since the candidates clear the surface around the peaks they tried.
+  // Computed ahead where the builder of both frames did (SpectraBuilder::correlateWithRecent):
+  // copied, since the candidates clear the surface around the peaks they tried.
   for (const RotationZoomCorrelation& ahead : newer.correlated) {
     if (older.serial == 0 || ahead.older_serial != older.serial) continue;
     const Fft2d& fft = context_->fft();
@@ -451,7 +451,7 @@ void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpec
   // rotation_zoom_power_ (its own buffer, so that the translation leaves it for the next
   // candidate).
   RotationZoomCorrelation here;
-  here.power = rotation_zoom_power_;
+  here.power = rotation_zoom_power_;  // the buffer is reused
   oefmt::correlateRotationZoom(*context_, newer.log_polar_spectrum, older.log_polar_spectrum, here);
   rotation_zoom_power_ = here.power;
   rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);

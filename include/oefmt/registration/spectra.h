@@ -65,7 +65,6 @@ class SpectralContext {
   std::vector<float> log_polar_cos_, log_polar_sin_, log_polar_radii_;
 };
 
-/// What the registration needs of one frame; computed once when the frame arrives.
 /// The rotation/zoom correlation surface of a frame with an older one (Registrar's first step),
 /// computed ahead by the SpectraBuilder that built both.
 struct RotationZoomCorrelation {
@@ -75,6 +74,7 @@ struct RotationZoomCorrelation {
   SurfaceStats stats;              ///< of the whole surface
 };
 
+/// What the registration needs of one frame; computed once when the frame arrives.
 struct FrameSpectra {
   cv::Mat1f grey;               ///< N x N prepared image (not apodized), warped when it is the older
   cv::Mat2f spectrum;           ///< FFT of the apodized grey image
@@ -86,7 +86,7 @@ struct FrameSpectra {
   RefinementImage refinement;   ///< smoothed grey for the zoom refinement (empty without it)
   /// Unique in the process (0: none): what a RotationZoomCorrelation names its older frame by.
   std::uint64_t serial = 0;
-  /// Correlations with the frames built just before this one (SpectraBuilder::setLookback).
+  /// Correlations with the frames built just before this one (SpectraBuilder::correlateWithRecent).
   std::vector<RotationZoomCorrelation> correlated;
 
   bool empty() const { return grey.empty(); }
