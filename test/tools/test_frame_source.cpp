@@ -77,10 +77,19 @@ PrefetchingSource::Analyse markingSpareWork() {
 }
 
 TEST(PrefetchingSource, SpareWorkRunsOnlyWhileTheConsumerHasAFrameQueued) {
+  const PrefetchingSource::Analyse record = recordingAnalysis();
   {
-    PrefetchingSource source(std::make_unique<CountingSource>(5, kNever, nullptr), 8, recordingAnalysis(),
-                             markingSpareWork());
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the reader reads all five
+    // The consumer starts only once all five frames are analysed.
+    std::atomic<std::size_t> analysed{0};
+    const auto counted = [record, &analysed](SourceFrame& frame) {
+      record(frame);
+      ++analysed;
+    };
+    PrefetchingSource source(std::make_unique<CountingSource>(5, kNever, nullptr), 8, counted, markingSpareWork());
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (analysed.load() < 5 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     SourceFrame frame;
     for (std::size_t k = 0; k < 5; ++k) {
       ASSERT_TRUE(source.next(frame));
@@ -88,15 +97,21 @@ TEST(PrefetchingSource, SpareWorkRunsOnlyWhileTheConsumerHasAFrameQueued) {
     }
   }
   {
-    const PrefetchingSource::Analyse record = recordingAnalysis();
-    const auto slow = [record](SourceFrame& frame) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // Frame k is analysed only once the consumer has taken every frame before it.
+    std::atomic<std::size_t> taken{0};
+    const auto paced = [record, &taken](SourceFrame& frame) {
+      // Bounded, so that a failing test cannot hang in the source's destructor.
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (taken.load() < frame.index && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
       record(frame);
     };
-    PrefetchingSource source(std::make_unique<CountingSource>(4, kNever, nullptr), 8, slow, markingSpareWork());
+    PrefetchingSource source(std::make_unique<CountingSource>(4, kNever, nullptr), 8, paced, markingSpareWork());
     SourceFrame frame;
     for (std::size_t k = 0; k < 4; ++k) {
-      ASSERT_TRUE(source.next(frame));  // waits for each: the queue is empty when the next is made
+      ASSERT_TRUE(source.next(frame));
+      ++taken;
       EXPECT_EQ(frame.spectra.mean, 0.0f) << k;
     }
   }
