@@ -199,6 +199,8 @@ struct Estimator::State {
   // they held) for the length the motion so far predicts: that step (oefmt mode), with
   // est.measured12 and est.vouched_length set.
   std::optional<PairMotion> corroboratedStep(Estimate& est) const;
+  /// corroboratedStep along the predicted direction, where the chosen peak lies off it.
+  std::optional<PairMotion> corroboratedAlongPrediction(Estimate& est);
   // Where the layer memory cannot vouch: the followed layer's own peak within `agreement` [px]
   // of the steady length (a layer of the energy vector, tracking.layer_min_fraction of its
   // maximum, else the highest correlation peak) [px], or none.
@@ -885,6 +887,44 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
   return step;
 }
 
+std::optional<PairMotion> Estimator::State::corroboratedAlongPrediction(Estimate& est) {
+  // corroboratedStep reads the layers along the chosen peak's direction. Over a periodic texture
+  // that peak may be an alias in another direction altogether (near zero shift, where every
+  // direction's row passes), with no confidence: the layers are then looked for along the
+  // predicted direction, and the same two readings must agree (a length the held depth ratios
+  // vouch for, within twice their tolerance of the predicted one). The step takes the predicted
+  // direction, with the prediction's own spread across it.
+  const PairRegistration& r = est.registration12;
+  if (!have01 || !prior12 || !(prior12->translation_radius > 0.0) ||
+      r.status != RegistrationStatus::kLowConfidence || r.rotation_zoom_implausible) {
+    return std::nullopt;
+  }
+  const double predicted = cv::norm(prior12->translation);
+  if (!(predicted > 0.0)) return std::nullopt;
+  const double steady = steadyLength(est);
+  const double agreement = 2.0 * kLayerRatioTolerance * steady;
+  const double direction = std::atan2(prior12->translation.y, prior12->translation.x);
+  std::vector<float> energy = registrar.translationEnergyAlong(direction, predicted);
+  std::vector<double> shifts;
+  const double shift_per_bin = registrar.shiftPerBin();
+  for (const EnergyPeak& peak : energyPeaks(energy, config.tracking.layer_min_fraction)) {
+    shifts.push_back(peak.bin * shift_per_bin);
+  }
+  const std::optional<LayerRatioMemory::Vouched> held = layer_ratios.vouch(shifts, steady);
+  if (!held || !(std::fabs(held->length - steady) <= agreement)) return std::nullopt;
+  PairMotion step = detail::calibrated(r, config.uncertainty);
+  step.translation = prior12->translation * (held->length / predicted);
+  step.translation_covariance =
+      alongAcrossCovariance(direction, std::max(kLayerRatioTolerance * held->length, detail::kMinShiftSigma),
+                            std::max(prior12->translation_sigma, detail::kMinShiftSigma));
+  est.measured12 = step;
+  est.vouched_length = held->length;
+  est.length_source = LengthSource::kVouched;
+  // The layers remembered with this step, and the next pair's pattern matching, read these.
+  est.registration12.translation_energy = std::move(energy);
+  return step;
+}
+
 std::optional<double> Estimator::State::followedLayerAtSteadyLength(const PairRegistration& r, double steady,
                                                                     double agreement) const {
   // The memory vouches for nothing while the layers in view are new to it (it needs most of a
@@ -1105,8 +1145,9 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       // against a weak pair. (The worker reads `frame`, which moves on below.)
       if (s.pending02.valid()) s.pending02.wait();
       s.pending02 = {};
-      const std::optional<PairMotion> corroborated =
+      std::optional<PairMotion> corroborated =
           config_.mode == EstimatorMode::kOefmt ? s.corroboratedStep(est) : std::nullopt;
+      if (!corroborated && config_.mode == EstimatorMode::kOefmt) corroborated = s.corroboratedAlongPrediction(est);
       if (corroborated) {
         est.degraded = true;
         s.advance(std::move(frame), *corroborated, std::vector<float>(est.registration12.translation_energy), est);

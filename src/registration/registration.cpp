@@ -582,6 +582,27 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   return confidence;
 }
 
+std::vector<float> Registrar::translationEnergyAlong(double direction, double length) {
+  const int n = context_->size();
+  if (surface_.empty() || !std::isfinite(direction)) return {};
+  const int band = kPolarBandHalfWidth;
+  const int centre_row = static_cast<int>(std::lround(direction * n / (2.0 * CV_PI)));
+  cv::Mat1f polar;
+  context_->polarRows(surface_, centre_row - band, 2 * band + 1, polar);
+  const double radius_step = context_->polarRadiusStep();
+  SurfacePeak peak;
+  peak.row = band;
+  peak.col = std::clamp(static_cast<int>(std::lround(length / radius_step)), 0, polar.cols - 1);
+  peak.value = polar(peak.row, peak.col);
+  peak.sub_row = peak.row;
+  peak.sub_col = peak.col;
+  EnergyVectorOptions options = energyVectorOptions(context_->config());
+  options.cyclic_cols = false;
+  options.suppress_low_cols = true;
+  options.row_band = 4;
+  return extractEnergyVector(polar, peak, options).values;
+}
+
 double Registrar::chooseTranslationPeak(const RegistrationPrior* prior, SurfacePeak& peak,
                                         PairRegistration& result) {
   const int n = context_->size();

@@ -333,6 +333,40 @@ TEST(Registration, TwoPlanesGiveTwoTranslationEnergyPeaks) {
   EXPECT_TRUE(hasPeakNear(r2.translation_energy, 30.0 / 0.75, 1.0, 0.03));
 }
 
+// The estimator reads the layers along the predicted direction where the chosen peak lies off it
+// (an alias): the energy vector along a given direction has the layers' peaks there, and none
+// along the opposite or a perpendicular direction.
+TEST(Registration, TheEnergyVectorAlongAGivenDirectionHoldsTheLayersMovingAlongIt) {
+  const cv::Mat1f ground = sim::proceduralTexture({2048, 2048}, 11, sim::TextureStyle::kCells, 40);
+  const cv::Mat1f roofs = sim::proceduralTexture({2048, 2048}, 12, sim::TextureStyle::kCells, 40);
+  const cv::Mat1f mask = sim::blockMask({2048, 2048}, 13, 96.0, 0.7);
+  const cv::Point2d centre(1024, 1024);
+  const double direction = rad(-62.0);
+  const cv::Point2d unit(std::cos(direction), std::sin(direction));
+  const cv::Mat1f older = sim::renderTwoLayerView(ground, roofs, mask, centre, {0, 0}, {0, 0}, kN);
+  const cv::Mat1f newer =
+      sim::renderTwoLayerView(ground, roofs, mask, centre, unit * 30.0, unit * 45.0, kN);
+  Registrar registrar(test::sharedContext(kN));
+  EXPECT_TRUE(registrar.translationEnergyAlong(direction, 30.0).empty());  // nothing registered yet
+  const PairRegistration r = registrar.registerPair(registrar.analyse(older), registrar.analyse(newer));
+  ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  const double bin = registrar.shiftPerBin();
+  const std::vector<float> along = registrar.translationEnergyAlong(direction, 30.0);
+  ASSERT_FALSE(along.empty());
+  EXPECT_TRUE(hasPeakNear(along, 30.0 / bin, 1.0, 0.03));
+  EXPECT_TRUE(hasPeakNear(along, 45.0 / bin, 1.0, 0.03));
+  for (const double off : {CV_PI, CV_PI / 2.0}) {
+    const std::vector<float> elsewhere = registrar.translationEnergyAlong(direction + off, 30.0);
+    ASSERT_EQ(elsewhere.size(), along.size());
+    // Normalised to unit sum: a vector without a layer spreads its energy thin.
+    for (const double shift : {30.0, 45.0}) {
+      const std::size_t j = static_cast<std::size_t>(std::lround(shift / bin));
+      EXPECT_LT(elsewhere[j], 0.25 * along[j]) << off << " " << shift;
+    }
+    EXPECT_LT(elsewhere[test::argmax(elsewhere)], along[static_cast<std::size_t>(std::lround(45.0 / bin))]) << off;
+  }
+}
+
 TEST(Registration, ConstantAndBlackFramesAreTextureless) {
   const auto pair = test::warpedPair(sim::ViewMotion{});
   const cv::Mat1f black(kN, kN, 0.0f);

@@ -224,6 +224,10 @@ class Registrar {
   double logZoomPerBin() const;
   /// Pixels of shift per translation-energy bin.
   double shiftPerBin() const { return context_->polarRadiusStep(); }
+  /// The translation energy vector of the pair registered last along `direction` [rad], its
+  /// energy row searched near there (as PairRegistration::translation_energy, which is read along
+  /// the chosen peak's direction); empty before any registration.
+  std::vector<float> translationEnergyAlong(double direction, double length);
   /// Rotation/zoom peaks this Registrar tries (default: the configuration's
   /// rotation_zoom_candidates); clamped to >= 1.
   void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
