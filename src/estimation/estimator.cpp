@@ -200,7 +200,7 @@ struct Estimator::State {
   // est.measured12 and est.vouched_length set.
   std::optional<PairMotion> corroboratedStep(Estimate& est) const;
   /// corroboratedStep along the predicted direction, where the chosen peak lies off it.
-  std::optional<PairMotion> corroboratedAlongPrediction(Estimate& est);
+  std::optional<PairMotion> corroboratedAlongPrediction(const WindowFrame& frame, Estimate& est);
   // Where the layer memory cannot vouch: the followed layer's own peak within `agreement` [px]
   // of the steady length (a layer of the energy vector, tracking.layer_min_fraction of its
   // maximum, else the highest correlation peak) [px], or none.
@@ -887,7 +887,7 @@ std::optional<PairMotion> Estimator::State::corroboratedStep(Estimate& est) cons
   return step;
 }
 
-std::optional<PairMotion> Estimator::State::corroboratedAlongPrediction(Estimate& est) {
+std::optional<PairMotion> Estimator::State::corroboratedAlongPrediction(const WindowFrame& frame, Estimate& est) {
   // corroboratedStep reads the layers along the chosen peak's direction. Over a periodic texture
   // that peak may be an alias in another direction altogether (near zero shift, where every
   // direction's row passes), with no confidence: the layers are then looked for along the
@@ -904,7 +904,9 @@ std::optional<PairMotion> Estimator::State::corroboratedAlongPrediction(Estimate
   const double steady = steadyLength(est);
   const double agreement = 2.0 * kLayerRatioTolerance * steady;
   const double direction = std::atan2(prior12->translation.y, prior12->translation.x);
-  std::vector<float> energy = registrar.translationEnergyAlong(direction, predicted);
+  // Empty unless the registrar's last surface is this pair's (a retry after a failed frame
+  // registers another pair).
+  std::vector<float> energy = registrar.translationEnergyAlong(f1->spectra, frame.spectra, direction, predicted);
   std::vector<double> shifts;
   const double shift_per_bin = registrar.shiftPerBin();
   for (const EnergyPeak& peak : energyPeaks(energy, config.tracking.layer_min_fraction)) {
@@ -1147,7 +1149,7 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
       s.pending02 = {};
       std::optional<PairMotion> corroborated =
           config_.mode == EstimatorMode::kOefmt ? s.corroboratedStep(est) : std::nullopt;
-      if (!corroborated && config_.mode == EstimatorMode::kOefmt) corroborated = s.corroboratedAlongPrediction(est);
+      if (!corroborated && config_.mode == EstimatorMode::kOefmt) corroborated = s.corroboratedAlongPrediction(frame, est);
       if (corroborated) {
         est.degraded = true;
         s.advance(std::move(frame), *corroborated, std::vector<float>(est.registration12.translation_energy), est);

@@ -233,6 +233,7 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
   const int n = context_->size();
   if (older.empty() || newer.empty()) throw InputError("registerPair: a frame is empty");
   max_rotation_ = max_rotation > 0.0 ? max_rotation : CV_PI;  // NaN: unbounded
+  surface_pair_ = {0, 0};
   if (older.grey.rows != n || newer.grey.rows != n || older.spectrum.size() != newer.spectrum.size()) {
     throw InputError("registerPair: frames were analysed at a different size than " +
                      std::to_string(n));
@@ -545,6 +546,7 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
                     SimdKernel::kAuto, newer.noise_power, older_noise);
   fft.inverseInPlace(cross_power_);
   surface_ = fft.realView(cross_power_);
+  surface_pair_ = {older.serial, newer.serial};
   SurfacePeak peak;
   const double confidence = chooseTranslationPeak(prior, peak, result);
   result.translation = cv::Point2d(peak.sub_col - n / 2, peak.sub_row - n / 2);
@@ -582,9 +584,13 @@ double Registrar::registerTranslation(const FrameSpectra& older, const FrameSpec
   return confidence;
 }
 
-std::vector<float> Registrar::translationEnergyAlong(double direction, double length) {
+std::vector<float> Registrar::translationEnergyAlong(const FrameSpectra& older, const FrameSpectra& newer,
+                                                    double direction, double length) {
   const int n = context_->size();
-  if (surface_.empty() || !std::isfinite(direction)) return {};
+  if (surface_.empty() || !std::isfinite(direction) || older.serial == 0 ||
+      surface_pair_ != std::make_pair(older.serial, newer.serial)) {
+    return {};
+  }
   const int band = kPolarBandHalfWidth;
   const int centre_row = static_cast<int>(std::lround(direction * n / (2.0 * CV_PI)));
   cv::Mat1f polar;

@@ -347,16 +347,18 @@ TEST(Registration, TheEnergyVectorAlongAGivenDirectionHoldsTheLayersMovingAlongI
   const cv::Mat1f newer =
       sim::renderTwoLayerView(ground, roofs, mask, centre, unit * 30.0, unit * 45.0, kN);
   Registrar registrar(test::sharedContext(kN));
-  EXPECT_TRUE(registrar.translationEnergyAlong(direction, 30.0).empty());  // nothing registered yet
-  const PairRegistration r = registrar.registerPair(registrar.analyse(older), registrar.analyse(newer));
+  const FrameSpectra a = registrar.analyse(older), b = registrar.analyse(newer);
+  EXPECT_TRUE(registrar.translationEnergyAlong(a, b, direction, 30.0).empty());  // not registered yet
+  const PairRegistration r = registrar.registerPair(a, b);
   ASSERT_EQ(r.status, RegistrationStatus::kOk);
+  EXPECT_TRUE(registrar.translationEnergyAlong(b, a, direction, 30.0).empty());  // another pair
   const double bin = registrar.shiftPerBin();
-  const std::vector<float> along = registrar.translationEnergyAlong(direction, 30.0);
+  const std::vector<float> along = registrar.translationEnergyAlong(a, b, direction, 30.0);
   ASSERT_FALSE(along.empty());
   EXPECT_TRUE(hasPeakNear(along, 30.0 / bin, 1.0, 0.03));
   EXPECT_TRUE(hasPeakNear(along, 45.0 / bin, 1.0, 0.03));
   for (const double off : {CV_PI, CV_PI / 2.0}) {
-    const std::vector<float> elsewhere = registrar.translationEnergyAlong(direction + off, 30.0);
+    const std::vector<float> elsewhere = registrar.translationEnergyAlong(a, b, direction + off, 30.0);
     ASSERT_EQ(elsewhere.size(), along.size());
     // Normalised to unit sum: a vector without a layer spreads its energy thin.
     for (const double shift : {30.0, 45.0}) {

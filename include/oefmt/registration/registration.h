@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <memory>
 #include <optional>
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -224,10 +226,12 @@ class Registrar {
   double logZoomPerBin() const;
   /// Pixels of shift per translation-energy bin.
   double shiftPerBin() const { return context_->polarRadiusStep(); }
-  /// The translation energy vector of the pair registered last along `direction` [rad], its
+  /// The translation energy vector of the pair older -> newer along `direction` [rad], its
   /// energy row searched near there (as PairRegistration::translation_energy, which is read along
-  /// the chosen peak's direction); empty before any registration.
-  std::vector<float> translationEnergyAlong(double direction, double length);
+  /// the chosen peak's direction), from its correlation surface `length` px out; empty unless
+  /// that pair is the one registered last (FrameSpectra::serial).
+  std::vector<float> translationEnergyAlong(const FrameSpectra& older, const FrameSpectra& newer,
+                                            double direction, double length);
   /// Rotation/zoom peaks this Registrar tries (default: the configuration's
   /// rotation_zoom_candidates); clamped to >= 1.
   void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
@@ -295,6 +299,8 @@ class Registrar {
   cv::Mat1f small_surface_, polar_;
   cv::Mat2f warped_spectrum_;
   int polar_first_row_ = 0;
+  // The frames (FrameSpectra::serial) whose translation surface surface_ holds; 0 for none.
+  std::pair<std::uint64_t, std::uint64_t> surface_pair_{0, 0};
   int rotation_zoom_candidates_;
   std::optional<cv::Point2d> plane_tilt_;
   double max_rotation_ = CV_PI;  // of the pair being registered (see registerPair)
