@@ -208,6 +208,7 @@ struct Estimator::State {
                                                     double agreement) const;
   // The shifts of the depth layers of pair 1-2 [px]: its translation energy peaks.
   std::vector<double> layerShifts(const PairRegistration& registration) const;
+  std::vector<double> layerShifts(const std::vector<float>& translation_energy) const;
   // The length the motion so far predicts for pair 1-2 [px] (needs have01).
   double steadyLength(const Estimate& est) const { return motion01.shift() * est.frame_gap / gap01; }
   // Whether a pair whose followed layer is predicted to move by `followed` [px] can be
@@ -815,9 +816,13 @@ void Estimator::State::advance(WindowFrame&& frame, const PairMotion& step,
 }
 
 std::vector<double> Estimator::State::layerShifts(const PairRegistration& registration) const {
+  return layerShifts(registration.translation_energy);
+}
+
+std::vector<double> Estimator::State::layerShifts(const std::vector<float>& translation_energy) const {
   std::vector<double> shifts;
   const double shift_per_bin = registrar.shiftPerBin();
-  for (const EnergyPeak& peak : energyPeaks(registration.translation_energy, config.tracking.layer_min_fraction)) {
+  for (const EnergyPeak& peak : energyPeaks(translation_energy, config.tracking.layer_min_fraction)) {
     shifts.push_back(peak.bin * shift_per_bin);
   }
   return shifts;
@@ -907,12 +912,7 @@ std::optional<PairMotion> Estimator::State::corroboratedAlongPrediction(const Wi
   // Empty unless the registrar's last surface is this pair's (a retry after a failed frame
   // registers another pair).
   std::vector<float> energy = registrar.translationEnergyAlong(f1->spectra, frame.spectra, direction, predicted);
-  std::vector<double> shifts;
-  const double shift_per_bin = registrar.shiftPerBin();
-  for (const EnergyPeak& peak : energyPeaks(energy, config.tracking.layer_min_fraction)) {
-    shifts.push_back(peak.bin * shift_per_bin);
-  }
-  const std::optional<LayerRatioMemory::Vouched> held = layer_ratios.vouch(shifts, steady);
+  const std::optional<LayerRatioMemory::Vouched> held = layer_ratios.vouch(layerShifts(energy), steady);
   if (!held || !(std::fabs(held->length - steady) <= agreement)) return std::nullopt;
   PairMotion step = detail::calibrated(r, config.uncertainty);
   step.translation = prior12->translation * (held->length / predicted);

@@ -432,32 +432,34 @@ void Registrar::registerOnPrior(const FrameSpectra& older, const FrameSpectra& n
 }
 
 void Registrar::correlateRotationZoom(const FrameSpectra& older, const FrameSpectra& newer) {
-  // Computed ahead where the builder of both frames did (SpectraBuilder::correlateWithRecent):
-  // copied, since the candidates clear the surface around the peaks they tried.
-  for (const RotationZoomCorrelation& ahead : newer.correlated) {
-    if (older.serial == 0 || ahead.older_serial != older.serial) continue;
-    const Fft2d& fft = context_->fft();
-    if (ahead.power.rows != fft.size() || ahead.power.cols != fft.spectrumCols() || !ahead.power.isContinuous()) {
-      break;  // not of this context's transforms (a caller's own FrameSpectra): computed here
-    }
-    ahead.power.copyTo(rotation_zoom_power_);
-    rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
-    rotation_zoom_highest_ = ahead.highest;
-    rotation_zoom_stats_ = ahead.stats;
-    return;
+  // Computed ahead where the builder of both frames did (SpectraBuilder::correlateWithRecent),
+  // unless it is not of this context's transforms (a caller's own FrameSpectra): copied, since
+  // the candidates clear the surface around the peaks they tried.
+  const Fft2d& fft = context_->fft();
+  const auto ahead = std::find_if(newer.correlated.begin(), newer.correlated.end(),
+                                  [&](const RotationZoomCorrelation& c) {
+                                    return older.serial != 0 && c.older_serial == older.serial &&
+                                           c.power.rows == fft.size() && c.power.cols == fft.spectrumCols() &&
+                                           c.power.isContinuous();
+                                  });
+  if (ahead != newer.correlated.end()) {
+    ahead->power.copyTo(rotation_zoom_power_);
+    rotation_zoom_highest_ = ahead->highest;
+    rotation_zoom_stats_ = ahead->stats;
+  } else {
+    // The full surface: a coarse low-resolution search for the rotation row (to invert only a
+    // band of rows) picked wrong rows on simulated flights, where much of the log-polar
+    // correlation's energy sits at high frequencies. In place: the surface is a view of
+    // rotation_zoom_power_ (its own buffer, so that the translation leaves it for the next
+    // candidate).
+    RotationZoomCorrelation here;
+    here.power = rotation_zoom_power_;  // the buffer is reused
+    oefmt::correlateRotationZoom(*context_, newer.log_polar_spectrum, older.log_polar_spectrum, here);
+    rotation_zoom_power_ = here.power;
+    rotation_zoom_highest_ = here.highest;
+    rotation_zoom_stats_ = here.stats;
   }
-  // The full surface: a coarse low-resolution search for the rotation row (to invert only a
-  // band of rows) picked wrong rows on simulated flights, where much of the log-polar
-  // correlation's energy sits at high frequencies. In place: the surface is a view of
-  // rotation_zoom_power_ (its own buffer, so that the translation leaves it for the next
-  // candidate).
-  RotationZoomCorrelation here;
-  here.power = rotation_zoom_power_;  // the buffer is reused
-  oefmt::correlateRotationZoom(*context_, newer.log_polar_spectrum, older.log_polar_spectrum, here);
-  rotation_zoom_power_ = here.power;
-  rotation_zoom_surface_ = context_->fft().realView(rotation_zoom_power_);
-  rotation_zoom_highest_ = here.highest;
-  rotation_zoom_stats_ = here.stats;
+  rotation_zoom_surface_ = fft.realView(rotation_zoom_power_);
 }
 
 double Registrar::registerRotationZoom(RegistrationMethod method, PairRegistration& result,
