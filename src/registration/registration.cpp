@@ -103,6 +103,15 @@ constexpr double kRefinementPixels = 3000.0;
 constexpr double kRefinementMaxBins = 2.0;
 // A change of the refinement's loss within this many of its standard errors is the pixels' noise.
 constexpr double kLossEvidence = 2.0;
+// A refinement whose last step turned the image's edge (N/2 from the centre) by more than this
+// many pixels had not settled: a fiftieth of a pixel is below what the images' interpolation can
+// tell, and where one layer fits, the fourth step moves it far less.
+constexpr double kSettledEdgeShift = 0.02;
+// A sigma of the blocks' rotation (BlockMotion) in sigmas of an unsettled refinement's (its normal
+// equations' widened by its last step): 90 % of the errors lie within 2.5 of the blocks' sigmas
+// and 4.2 of the refinement's on the calibration flights of scripts/calibrate_rotation_sigma.py
+// (70 unsettled pairs), hence 0.6.
+constexpr double kBlockSigmaInRefinementSigmas = 0.6;
 // otherLayerShifts: how many peaks, and how near the followed shift a peak is the same layer.
 constexpr int kOtherLayers = 4;
 constexpr double kSameLayerPx = 3.0;
@@ -148,7 +157,7 @@ double slopeTowardsPrediction(double correction, double to_prediction) {
 // beside the surface's, and the estimator weighs the two (doc/method.md).
 void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const SpectralContext& context,
                 double log_zoom_per_bin, const std::optional<cv::Point2d>& plane_tilt,
-                const RegistrationPrior* prior, PairRegistration& result) {
+                const RegistrationPrior* prior, BlockMotionReader* blocks, PairRegistration& result) {
   if (older.refinement.empty() || newer.refinement.empty()) return;
   const int n = context.size();
   ImageSimilarity start;
@@ -185,6 +194,37 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   }
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
+  // An unsettled refinement was still on its way when it stopped: towards several layers'
+  // compromise (walls in view, whose shift grows with their height), or along the valley of a
+  // striped texture, where a turn and a zoom together slide the stripes along themselves. Its
+  // normal equations pin the rotation as tightly all the same: it is uncertain by at least its
+  // last step. The blocks that follow the pair's shift read the rigid layer's rotation beside it,
+  // and the two readings weigh by their sigmas; the unsettled steps' stretch is no evidence and
+  // is not reported. The zoom stays the refinement's: the blocks' zoom, weighed in as well,
+  // lowered the corpus's worst drift further but turned a periodic tiles flight onto another
+  // layer (doc/method.md). A levelled view keeps the refinement's reading, whose stretch tells
+  // its attitude source's error (below).
+  const double edge = 0.5 * n;
+  const bool settled = std::fabs(refined.last_rotation_step) * edge <= kSettledEdgeShift;
+  if (!settled && !plane_tilt && blocks != nullptr) {
+    ImageSimilarity at = refined.similarity;
+    at.stretch_a = at.stretch_b = 0.0;
+    const BlockMotion motion = blocks->read(older.grey, newer.grey, at);
+    if (motion.valid && motion.rotation_sigma > 0.0) {
+      result.motion_blocks = motion.blocks;
+      const double block_sigma = kBlockSigmaInRefinementSigmas * motion.rotation_sigma;
+      if (!(refined.loss_change < 0.0)) {
+        result.refined_rotation = motion.rotation;
+        result.refined_rotation_sigma = block_sigma;
+      } else {
+        const double sigma = std::hypot(refined.rotation_sigma, refined.last_rotation_step);
+        const double weight = sigma * sigma / (sigma * sigma + block_sigma * block_sigma);
+        result.refined_rotation = refined.similarity.rotation + weight * (motion.rotation - refined.similarity.rotation);
+        result.refined_rotation_sigma = 1.0 / std::sqrt(1.0 / (sigma * sigma) + 1.0 / (block_sigma * block_sigma));
+      }
+      return;
+    }
+  }
   result.stretch_a = refined.similarity.stretch_a;
   result.stretch_b = refined.similarity.stretch_b;
   // A refinement that did not lower the loss still reads the sub-bin zoom the surface cannot,
@@ -216,7 +256,9 @@ Registrar::Registrar(const RegistrationConfig& config)
 Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
     : context_(std::move(context)),
       builder_(context_),
-      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {}
+      rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {
+  if (context_->size() >= 64) blocks_.emplace(context_->size(), context_->config().fft_planning);
+}
 
 FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {
   return builder_.build(image, order);
@@ -387,7 +429,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
   if (result.status == RegistrationStatus::kOk && context_->config().refine_zoom) {
-    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, prior, result);
+    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, prior, blocks_ ? &*blocks_ : nullptr, result);
   }
 }
 

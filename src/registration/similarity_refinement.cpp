@@ -660,6 +660,7 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
         }
       }
     }
+    out.last_rotation_step = step[0];
     current.rotation += step[0];
     current.log_zoom += step[1];
     current.translation.x += step[2];

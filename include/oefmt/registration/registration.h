@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "oefmt/enum_names.h"
+#include "oefmt/registration/block_motion.h"
 #include "oefmt/registration/registration_config.h"
 #include "oefmt/registration/phase_correlation.h"
 #include "oefmt/registration/spectra.h"
@@ -108,6 +109,12 @@ struct PairRegistration {
   /// weighs the two (doc/method.md).
   double refined_rotation = 0.0;
   double refined_rotation_sigma = 0.0;
+  /// The refinement had not settled (its last step still moved the image's edge by more than a
+  /// fiftieth of a pixel): it was heading for several layers' compromise, or along a valley of a
+  /// striped texture. The blocks that follow the pair's shift (BlockMotionReader) read the
+  /// rotation beside it: refined_rotation and its sigma weigh both readings, and this counts the
+  /// blocks (0: the refinement's own reading, or none).
+  int motion_blocks = 0;
   double stretch_a = 0.0;
   double stretch_b = 0.0;
   /// ln(zoom) added for the ground plane's tilt or the followed surface's slope
@@ -290,6 +297,7 @@ class Registrar {
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
+  std::optional<BlockMotionReader> blocks_;  // frames of at least 64 px
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
   cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)

@@ -69,6 +69,9 @@ struct SimilarityRefinement {
   /// Cells of the kept blocks (3 x 3 pixels of the sparse grid each) left out because another
   /// shift along the motion fits them better.
   int dropped_cells = 0;
+  /// The last step's change of the rotation [rad]: how far the iteration still moved when it
+  /// stopped (one that has found its minimum moves it by a tiny fraction of its first step).
+  double last_rotation_step = 0.0;
 };
 
 /// Gauss-Newton on B(x) = gain * A(warp(x)) + bias over the pixels both frames see (inside both,
