@@ -110,6 +110,10 @@ struct Estimator::State {
     // A pair 0-2 that does not register only costs this frame its loop: the further rotation/zoom
     // candidates (up to 4 more registrations, on the tail latency) are kept for pair 1-2.
     registrar02.setRotationZoomCandidates(1);
+    // Pair 0-2's turn meets pairs 0-1's and 1-2's in the loop, where the blocks' reading of pair
+    // 1-2 already stands: read for pair 0-2 as well, they doubled their time for little
+    // (doc/method.md, Rotation and zoom).
+    registrar02.setBlockReading(false);
   }
 
   void clear() {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -13,11 +14,12 @@
 namespace oefmt {
 namespace {
 
-// Blocks per side of the grid, and the margin [px] kept from the frame's edge, where the
-// apodization and the sampling's interpolation leave too little texture.
+// The blocks' side is the frame's over kBlocksPerSide (seven of them fit a side within the
+// margin [px] kept from the frame's edge, where the apodization and the sampling's interpolation
+// leave too little texture); frames under kMinImageSize give blocks too small to correlate.
 constexpr int kBlocksPerSide = 8;
-constexpr int kMinImageSize = 64;
 constexpr int kEdgeMargin = 8;
+constexpr int kMinImageSize = 64;
 // A block follows the pair's motion when its remaining shift lies within this many pixels: the
 // similarity it is sampled at is within a pixel or two at the image's edge, while another depth
 // layer or a periodic texture's alias lies further off.

@@ -429,7 +429,8 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
                       ? RegistrationStatus::kOk
                       : RegistrationStatus::kLowConfidence;
   if (result.status == RegistrationStatus::kOk && context_->config().refine_zoom) {
-    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, prior, blocks_ ? &*blocks_ : nullptr, result);
+    refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, prior,
+               blocks_ && block_reading_ ? &*blocks_ : nullptr, result);
   }
 }
 

@@ -242,6 +242,9 @@ class Registrar {
   /// Rotation/zoom peaks this Registrar tries (default: the configuration's
   /// rotation_zoom_candidates); clamped to >= 1.
   void setRotationZoomCandidates(int candidates) { rotation_zoom_candidates_ = std::max(1, candidates); }
+  /// Whether the image blocks read the rotation of a pair whose zoom refinement did not settle
+  /// (PairRegistration::motion_blocks; default: yes, for frames of at least 64 px).
+  void setBlockReading(bool on) { block_reading_ = on; }
   /// Frames levelled by an attitude source: the ground plane's tilt left in the level view
   /// [1/px, image axes] (the source's error), for which the refined zooms are corrected
   /// (oefmt/registration/plane_tilt.h) from the tilt set, the reading of the pairs' stretch
@@ -298,6 +301,7 @@ class Registrar {
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
   std::optional<BlockMotionReader> blocks_;  // frames of at least 64 px
+  bool block_reading_ = true;
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
   cv::Mat1f surface_;  // the translation correlation surface: a view of cross_power_ (in-place FFT)
