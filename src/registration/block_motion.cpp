@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/registration/phase_correlation.h"
 #include "oefmt/registration/warp.h"
 
 namespace oefmt {
@@ -116,20 +117,9 @@ bool BlockMotionReader::blockShift(const cv::Mat1f& older, const cv::Mat1f& newe
   }
   fft_.forwardInPlace(older_spectrum_);
   fft_.forwardInPlace(newer_spectrum_);
-  // Normalised cross power: newer times the conjugate of older, so that the peak lies at the
-  // newer block's shift.
-  for (int r = 0; r < older_spectrum_.rows; ++r) {
-    const float* a = older_spectrum_.ptr<float>(r);
-    float* b = newer_spectrum_.ptr<float>(r);
-    for (int c = 0; c < 2 * older_spectrum_.cols; c += 2) {
-      const float re = b[c] * a[c] + b[c + 1] * a[c + 1];
-      const float im = b[c + 1] * a[c] - b[c] * a[c + 1];
-      const float power = re * re + im * im;
-      const float scale = power > 0.0f ? 1.0f / std::sqrt(power) : 0.0f;
-      b[c] = re * scale;
-      b[c + 1] = im * scale;
-    }
-  }
+  // Normalised cross power (newer times the conjugate of older: the peak lies at the newer
+  // block's shift), in place of the newer block's spectrum.
+  normalisedCrossPower(newer_spectrum_, older_spectrum_, newer_spectrum_);
   fft_.inverseInPlace(newer_spectrum_);
   surface_ = fft_.realView(newer_spectrum_);
   float height = surface_(0, 0);
