@@ -12,6 +12,11 @@ share of errors (90 %) lies within the sigma for both:
 
   refined_rotation_scale = q90(|refined error| / refined sigma) / q90(|surface error| / surface sigma)
 
+Where the refinement had not settled, the image blocks read the rotation (motion_blocks > 0), with
+their sigma times a factor that puts it in refinement sigmas (kBlockSigmaInRefinementSigmas in
+registration.cpp); the factor that gives the blocks' readings the same q90 as the refinement's is
+printed beside the scale: the shipped factor times q90(blocks) / q90(refinement).
+
   scripts/calibrate_rotation_sigma.py [--tools build/devel/lib/oefmt] [--work build/calibration]
 """
 import argparse
@@ -33,6 +38,8 @@ FLIGHTS = [
     ("brick", ["--seed", "46", "--texture-style", "brick"]),
 ]
 FRAMES = "80"
+# kBlockSigmaInRefinementSigmas in src/registration/registration.cpp, as shipped.
+BLOCK_SIGMA_FACTOR = 0.74
 ROTATION_SCALE_KEY = "rotation_scale:"
 CALLER = "calibrate_rotation_sigma"
 
@@ -55,7 +62,7 @@ def ratios(tools, work, name, options, surface_scale):
     diagnostics = os.path.join(work, name + ".csv")
     common.run([os.path.join(tools, "oefmt_offline"), "--quiet", "--images", folder, "--mode", "oefmt",
                 "--output", os.path.join(work, name + ".tum"), "--diagnostics", diagnostics], CALLER)
-    surface, refined = [], []
+    surface, refined, blocks = [], [], []
     with open(diagnostics, newline="") as table:
         for row in csv.DictReader(table):
             sigma_refined = float(row["sigma_refined_theta_rad"])
@@ -63,8 +70,9 @@ def ratios(tools, work, name, options, surface_scale):
                 continue
             # A fixed heading: the true rotation of every pair is zero.
             surface.append(abs(float(row["theta_rad"])) / (surface_scale * float(row["sigma_theta_rad"])))
-            refined.append(abs(float(row["refined_theta_rad"])) / sigma_refined)
-    return surface, refined
+            ratio = abs(float(row["refined_theta_rad"])) / sigma_refined
+            (blocks if int(row["motion_blocks"]) > 0 else refined).append(ratio)
+    return surface, refined, blocks
 
 
 def main():
@@ -75,21 +83,28 @@ def main():
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     surface_scale = rotation_scale(args.tools)
-    all_surface, all_refined = [], []
+    all_surface, all_refined, all_blocks = [], [], []
     for name, options in FLIGHTS:
-        surface, refined = ratios(args.tools, args.work, name, options, surface_scale)
-        if not surface:
+        surface, refined, blocks = ratios(args.tools, args.work, name, options, surface_scale)
+        if not refined:
             print(f"{name:10s} no refined pair")
             continue
+        blocks_q90 = f"{quantile(blocks, 0.9):.2f}" if blocks else "-"
         print(f"{name:10s} {len(surface):3d} pairs: 90 % of errors within {quantile(surface, 0.9):.2f} surface "
-              f"sigmas, {quantile(refined, 0.9):.2f} refinement sigmas")
+              f"sigmas, {quantile(refined, 0.9):.2f} refinement sigmas; {len(blocks)} read by blocks: "
+              f"{blocks_q90}")
         all_surface += surface
         all_refined += refined
-    if not all_surface:
+        all_blocks += blocks
+    if not all_refined:
         sys.exit("no refined pair in any flight")
     q_surface, q_refined = quantile(all_surface, 0.9), quantile(all_refined, 0.9)
     print(f"all        {len(all_surface):3d} pairs: {q_surface:.2f} surface sigmas, {q_refined:.2f} refinement "
           f"sigmas -> refined_rotation_scale {q_refined / q_surface:.1f}")
+    if all_blocks:
+        q_blocks = quantile(all_blocks, 0.9)
+        print(f"blocks     {len(all_blocks):3d} pairs: {q_blocks:.2f} sigmas -> the blocks' sigma factor "
+              f"{BLOCK_SIGMA_FACTOR * q_blocks / q_refined:.2f} (shipped {BLOCK_SIGMA_FACTOR})")
 
 
 if __name__ == "__main__":

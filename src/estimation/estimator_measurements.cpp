@@ -279,12 +279,15 @@ PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
   if (!predicted && r.zoom_refined && r.refined_rotation_sigma > 0.0 && std::isfinite(r.refined_rotation)) {
     // Two readings of the rotation: the surface's peak, whose fraction of a bin leans towards
     // or away from the whole bin by a few hundredths of a bin (every frame alike in a steady
-    // turn, so the heading drifts), and the refinement's, unbiased on one plane but noisy on weak
-    // texture and pulled by other depth layers. Each weighs by its error sigma.
+    // turn, so the heading drifts), and the refinement's (or, where it had not settled, the
+    // image blocks'), unbiased on one plane but noisy on weak texture. Each weighs by its error
+    // sigma, and the mean has the sigma of both: the loop weighs this pair's rotation against
+    // pair 0-2's by it.
     const double surface = m.rotation_sigma;
     const double refined = std::max(r.refined_rotation_sigma * u.refined_rotation_scale, kMinRotationSigma);
     const double weight = surface * surface / (surface * surface + refined * refined);
     m.rotation = wrapToPi(m.rotation + weight * wrapToPi(r.refined_rotation - r.rotation));
+    m.rotation_sigma = std::max(surface * refined / std::hypot(surface, refined), kMinRotationSigma);
   }
   const double shift = m.shift();
   const double along = std::max(finiteOr(r.shift_sigma, 1e3) * u.shift_scale, kMinShiftSigma);

@@ -2,6 +2,7 @@
 #include "oefmt/registration/block_motion.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -31,10 +32,13 @@ constexpr double kMinBlockPeak = 0.15;
 // Fewest following blocks that read a rotation and zoom: four unknowns, two readings a block.
 constexpr int kMinBlocks = 4;
 // The fit's robust weights: Tukey's biweight at this many robust scatters, over this many passes;
-// the scatter's floor [px] (a rigid layer's blocks agree to a few hundredths of a pixel).
+// the scatter's floor per component [px] (a rigid layer's blocks agree to a few hundredths of a
+// pixel).
 constexpr double kTukeyScatters = 4.685;
 constexpr int kFitPasses = 5;
-constexpr double kScatterFloor = 0.03;
+constexpr double kAxisScatterFloor = 0.02;
+// Below this shift [px] its direction, and with it "across the motion", is not known.
+constexpr double kMinAcrossShift = 1.0;
 // The median absolute deviation of a normal distribution, in its sigmas.
 constexpr double kMadToSigma = 1.4826;
 
@@ -63,6 +67,64 @@ double median(std::vector<double> v) {
   const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), middle, v.end());
   return *middle;
+}
+
+// R readings of one block's shift: rows of the fit's K unknowns and the values they should give.
+template <int K, int R>
+struct BlockReadings {
+  std::array<cv::Vec<double, K>, R> rows;
+  std::array<double, R> values;
+};
+
+template <int K>
+struct RobustFit {
+  bool solved = false;
+  cv::Vec<double, K> unknowns;
+  cv::Matx<double, K, K> covariance;  // from the scatter over the fit's degrees of freedom
+  int blocks = 0;                     // blocks the fit kept
+};
+
+// Least squares with Tukey's biweight on each block's residual length, the scatter from its
+// median. The covariance scales the normal equations' inverse by the scatter per reading over the
+// readings less the unknowns: a fit of few blocks has found a scatter smaller than theirs.
+template <int K, int R>
+RobustFit<K> robustFit(const std::vector<BlockReadings<K, R>>& blocks) {
+  RobustFit<K> fit;
+  std::vector<double> weights(blocks.size(), 1.0), residuals(blocks.size());
+  cv::Matx<double, K, K> normal;
+  double axis_scatter = kAxisScatterFloor;
+  for (int pass = 0; pass < kFitPasses; ++pass) {
+    normal = cv::Matx<double, K, K>::zeros();
+    cv::Vec<double, K> rhs = cv::Vec<double, K>::all(0.0);
+    fit.blocks = 0;
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      if (!(weights[i] > 0.0)) continue;
+      ++fit.blocks;
+      for (int k = 0; k < R; ++k) {
+        normal += weights[i] * (blocks[i].rows[k] * blocks[i].rows[k].t());
+        rhs += weights[i] * blocks[i].values[k] * blocks[i].rows[k];
+      }
+    }
+    if (fit.blocks < kMinBlocks || !cv::solve(normal, rhs, fit.unknowns, cv::DECOMP_CHOLESKY)) return fit;
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      double squares = 0.0;
+      for (int k = 0; k < R; ++k) {
+        const double off = blocks[i].values[k] - blocks[i].rows[k].dot(fit.unknowns);
+        squares += off * off;
+      }
+      residuals[i] = std::sqrt(squares);
+    }
+    axis_scatter = std::max(kMadToSigma * median(residuals) / std::sqrt(double(R)), kAxisScatterFloor);
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const double u = residuals[i] / (kTukeyScatters * std::sqrt(double(R)) * axis_scatter);
+      weights[i] = u < 1.0 ? (1.0 - u * u) * (1.0 - u * u) : 0.0;
+    }
+  }
+  const int readings = R * fit.blocks;
+  if (readings <= K) return fit;
+  fit.solved = true;
+  fit.covariance = normal.inv(cv::DECOMP_CHOLESKY) * (axis_scatter * axis_scatter * readings / (readings - K));
+  return fit;
 }
 
 }  // namespace
@@ -144,7 +206,8 @@ bool BlockMotionReader::blockShift(const cv::Mat1f& older, const cv::Mat1f& newe
   return std::hypot(x, y) <= kFollowRadius;
 }
 
-BlockMotion BlockMotionReader::read(const cv::Mat1f& older, const cv::Mat1f& newer, const ImageSimilarity& motion) {
+BlockMotion BlockMotionReader::read(const cv::Mat1f& older, const cv::Mat1f& newer, const ImageSimilarity& motion,
+                                     BlockFit fit) {
   if (older.rows != size_ || older.cols != size_ || newer.size() != older.size()) {
     throw InputError("BlockMotionReader::read: the frames are not " + std::to_string(size_) + " x " +
                      std::to_string(size_));
@@ -173,48 +236,65 @@ BlockMotion BlockMotionReader::read(const cv::Mat1f& older, const cv::Mat1f& new
       shifts_.push_back({{x0 + half - centre, y0 + half - centre}, shift});
     }
   }
+  tried_ = out.tried;
   out.blocks = static_cast<int>(shifts_.size());
   if (out.blocks < kMinBlocks) return out;
+  const double length = cv::norm(motion.translation);
+  const bool across_known = length >= kMinAcrossShift;
+  if (fit == BlockFit::kAcrossMotion && !across_known) return out;
+  const cv::Point2d across = across_known ? cv::Point2d(-motion.translation.y, motion.translation.x) / length
+                                          : cv::Point2d();
+  if (fit == BlockFit::kBoth || !across_known) return fitShifts(motion, nullptr);
+  if (fit == BlockFit::kAcrossMotion) return fitShifts(motion, &across);
+  const BlockMotion both = fitShifts(motion, nullptr), across_only = fitShifts(motion, &across);
+  if (!across_only.valid) return both;
+  if (!both.valid) return across_only;
+  return across_only.rotation_sigma < both.rotation_sigma ? across_only : both;
+}
+
+BlockMotion BlockMotionReader::fitShifts(const ImageSimilarity& motion, const cv::Point2d* across) {
   // The block at p shifted by r: r = t + w J p + e p, J p = (-p_y, p_x), for the newer frame
   // sampled at the motion; its true motion is then turned by -w and zoomed by -e on top of it.
-  std::vector<double> weights(shifts_.size(), 1.0), residuals(shifts_.size());
-  cv::Matx44d normal;
-  cv::Vec4d fit;
-  double scatter = kScatterFloor;
-  int used = 0;
-  for (int pass = 0; pass < kFitPasses; ++pass) {
-    normal = cv::Matx44d::zeros();
-    cv::Vec4d rhs = cv::Vec4d::all(0.0);
-    used = 0;
-    for (std::size_t i = 0; i < shifts_.size(); ++i) {
-      if (!(weights[i] > 0.0)) continue;
-      ++used;
-      const cv::Point2d& p = shifts_[i].position;
-      const cv::Vec4d jx(1.0, 0.0, -p.y, p.x), jy(0.0, 1.0, p.x, p.y);
-      normal += weights[i] * (jx * jx.t() + jy * jy.t());
-      rhs += weights[i] * (jx * shifts_[i].shift.x + jy * shifts_[i].shift.y);
+  BlockMotion out;
+  out.tried = tried_;
+  out.blocks = static_cast<int>(shifts_.size());
+  out.across_motion = across != nullptr;
+  double turn = 0.0, zoom = 0.0;
+  if (across == nullptr) {
+    std::vector<BlockReadings<4, 2>> readings;
+    readings.reserve(shifts_.size());
+    for (const BlockShift& b : shifts_) {
+      const cv::Point2d& p = b.position;
+      readings.push_back({{cv::Vec4d(1.0, 0.0, -p.y, p.x), cv::Vec4d(0.0, 1.0, p.x, p.y)}, {b.shift.x, b.shift.y}});
     }
-    if (used < kMinBlocks || !cv::solve(normal, rhs, fit, cv::DECOMP_CHOLESKY)) return out;
-    for (std::size_t i = 0; i < shifts_.size(); ++i) {
-      const cv::Point2d& p = shifts_[i].position;
-      const cv::Point2d predicted(fit[0] - fit[2] * p.y + fit[3] * p.x, fit[1] + fit[2] * p.x + fit[3] * p.y);
-      residuals[i] = cv::norm(shifts_[i].shift - predicted);
+    const RobustFit<4> fit = robustFit(readings);
+    if (!fit.solved) return out;
+    turn = fit.unknowns[2];
+    zoom = fit.unknowns[3];
+    out.rotation_sigma = std::sqrt(std::max(fit.covariance(2, 2), 0.0));
+    out.log_zoom_sigma = std::sqrt(std::max(fit.covariance(3, 3), 0.0));
+    out.blocks = fit.blocks;
+  } else {
+    // n . r = t_n + w (n . J p) + e (n . p): the shift along the motion, where depth adds its
+    // own, is not read.
+    const cv::Point2d n = *across;
+    std::vector<BlockReadings<3, 1>> readings;
+    readings.reserve(shifts_.size());
+    for (const BlockShift& b : shifts_) {
+      const cv::Point2d& p = b.position;
+      readings.push_back({{cv::Vec3d(1.0, n.y * p.x - n.x * p.y, n.dot(p))}, {n.dot(b.shift)}});
     }
-    scatter = std::max(kMadToSigma * median(residuals), kScatterFloor);
-    for (std::size_t i = 0; i < shifts_.size(); ++i) {
-      const double u = residuals[i] / (kTukeyScatters * scatter);
-      weights[i] = u < 1.0 ? (1.0 - u * u) * (1.0 - u * u) : 0.0;
-    }
+    const RobustFit<3> fit = robustFit(readings);
+    if (!fit.solved) return out;
+    turn = fit.unknowns[1];
+    zoom = fit.unknowns[2];
+    out.rotation_sigma = std::sqrt(std::max(fit.covariance(1, 1), 0.0));
+    out.log_zoom_sigma = std::sqrt(std::max(fit.covariance(2, 2), 0.0));
+    out.blocks = fit.blocks;
   }
-  const cv::Matx44d covariance = normal.inv(cv::DECOMP_CHOLESKY);
-  // The scatter is of a 2-D residual's length: per axis, over sqrt(2).
-  const double axis_scatter = scatter / std::sqrt(2.0);
   out.valid = true;
-  out.rotation = motion.rotation - fit[2];
-  out.log_zoom = motion.log_zoom + fit[3];
-  out.rotation_sigma = axis_scatter * std::sqrt(std::max(covariance(2, 2), 0.0));
-  out.log_zoom_sigma = axis_scatter * std::sqrt(std::max(covariance(3, 3), 0.0));
-  out.blocks = used;
+  out.rotation = motion.rotation - turn;
+  out.log_zoom = motion.log_zoom + zoom;
   return out;
 }
 

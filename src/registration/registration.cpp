@@ -111,7 +111,7 @@ constexpr double kSettledEdgeShift = 0.02;
 // equations' widened by its last step): 90 % of the errors lie within 2.5 of the blocks' sigmas
 // and 4.2 of the refinement's on the calibration flights of scripts/calibrate_rotation_sigma.py
 // (70 unsettled pairs), hence 0.6.
-constexpr double kBlockSigmaInRefinementSigmas = 0.6;
+constexpr double kBlockSigmaInRefinementSigmas = 0.74;
 // otherLayerShifts: how many peaks, and how near the followed shift a peak is the same layer.
 constexpr int kOtherLayers = 4;
 constexpr double kSameLayerPx = 3.0;
@@ -197,13 +197,14 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   // An unsettled refinement was still on its way when it stopped: towards several layers'
   // compromise (walls in view, whose shift grows with their height), or along the valley of a
   // striped texture, where a turn and a zoom together slide the stripes along themselves. Its
-  // normal equations pin the rotation as tightly all the same: it is uncertain by at least its
-  // last step. The blocks that follow the pair's shift read the rigid layer's rotation beside it,
-  // and the two readings weigh by their sigmas; the unsettled steps' stretch is no evidence and
-  // is not reported. The zoom stays the refinement's: the blocks' zoom, weighed in as well,
-  // lowered the corpus's worst drift further but turned a periodic tiles flight onto another
-  // layer (doc/method.md). A levelled view keeps the refinement's reading, whose stretch tells
-  // its attitude source's error (below).
+  // normal equations pin the rotation as tightly all the same, and where it stops depends on
+  // the layers in view: its error is a bias, not noise that a weighted mean would average out.
+  // The blocks that follow the pair's shift read the turn instead, across the motion where
+  // depth layers pull (block_motion.h); the unsettled steps' stretch is no evidence and is not
+  // reported. The zoom stays the refinement's: the blocks' zoom, taken as well, lowered the
+  // corpus's worst drift further but turned a periodic tiles flight onto another layer
+  // (doc/method.md). A levelled view keeps the refinement's reading, whose stretch tells its
+  // attitude source's error (below).
   const double edge = 0.5 * n;
   const bool settled = std::fabs(refined.last_rotation_step) * edge <= kSettledEdgeShift;
   if (!settled && !plane_tilt && blocks != nullptr) {
@@ -212,16 +213,8 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
     const BlockMotion motion = blocks->read(older.grey, newer.grey, at);
     if (motion.valid && motion.rotation_sigma > 0.0) {
       result.motion_blocks = motion.blocks;
-      const double block_sigma = kBlockSigmaInRefinementSigmas * motion.rotation_sigma;
-      if (!(refined.loss_change < 0.0)) {
-        result.refined_rotation = motion.rotation;
-        result.refined_rotation_sigma = block_sigma;
-      } else {
-        const double sigma = std::hypot(refined.rotation_sigma, refined.last_rotation_step);
-        const double weight = sigma * sigma / (sigma * sigma + block_sigma * block_sigma);
-        result.refined_rotation = refined.similarity.rotation + weight * (motion.rotation - refined.similarity.rotation);
-        result.refined_rotation_sigma = 1.0 / std::sqrt(1.0 / (sigma * sigma) + 1.0 / (block_sigma * block_sigma));
-      }
+      result.refined_rotation = motion.rotation;
+      result.refined_rotation_sigma = kBlockSigmaInRefinementSigmas * motion.rotation_sigma;
       return;
     }
   }

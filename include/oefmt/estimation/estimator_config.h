@@ -96,7 +96,7 @@ struct UncertaintyConfig {
   double shift_scale = 0.1;      ///< error along d / shift_sigma
   double direction_scale = 0.3;  ///< error across d / (shift * direction_sigma)
   /// theta error / the zoom refinement's rotation sigma (PairRegistration::refined_rotation_sigma)
-  double refined_rotation_scale = 3.5;
+  double refined_rotation_scale = 3.1;
 
   void validate() const;
 };
