@@ -24,7 +24,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using detail::alongTrackSigma;
-using detail::medianOf;
 using detail::kMinShiftSigma;
 
 double msSince(Clock::time_point start) {

@@ -365,11 +365,6 @@ PairMotion perInterval(const PairMotion& m, int gap) {
   return out;
 }
 
-double medianOf(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
 PairMotion extrapolatedStep(const PairMotion& last, const std::deque<PairMotion>& rates) {
   PairMotion step = last;
   if (rates.empty()) return step;
@@ -412,9 +407,8 @@ bool RateDeviations::outlier(double deviation, bool may_change_rate) {
 
 double RateDeviations::spread() const {
   // The median absolute deviation over that of a normal distribution's sigma.
-  constexpr double kMedianAbsoluteToSigma = 1.4826;
   if (deviations_.empty()) return floor_;
-  return std::max(kMedianAbsoluteToSigma * medianOf({deviations_.begin(), deviations_.end()}), floor_);
+  return std::max(kMadToSigma * medianOf({deviations_.begin(), deviations_.end()}), floor_);
 }
 
 void RateDeviations::clear() {

@@ -12,6 +12,7 @@
 #include "oefmt/estimation/pair_motion.h"
 #include "oefmt/registration/pattern_matching.h"
 #include "oefmt/registration/registration.h"
+#include "oefmt/registration/robust_statistics.h"
 
 namespace oefmt {
 namespace detail {
@@ -31,9 +32,6 @@ PairMotion withLength(const PairMotion& motion, double length, double along, dou
 
 /// The motion of one frame interval from a motion spanning `gap` intervals.
 PairMotion perInterval(const PairMotion& motion, int gap);
-
-/// The middle value (the upper middle of an even count); `values` must not be empty.
-double medianOf(std::vector<double> values);
 
 /// The step a frame that could not be registered is extrapolated with: the last step's
 /// translation, turned and zoomed at the median rates of `rates` (the last steps that measured

@@ -6,31 +6,25 @@
 #include <vector>
 
 #include "oefmt/registration/plane_tilt.h"
+#include "oefmt/registration/robust_statistics.h"
 
 namespace oefmt {
 namespace {
 
 // Gaussian sigma per median absolute deviation.
-constexpr double kMadToSigma = 1.4826;
 // Tukey's biweight threshold in robust sigmas (95 % efficiency on Gaussian readings): readings
 // far from the median (parallax) count for nothing, and a reading's weight falls smoothly on the
 // way there, so that a tiny change of one reading never flips the line.
 constexpr double kTukey = 4.685;
 
-double median(std::vector<double> values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
 // The value at the last index of a weighted least-squares line through `values` (index = arrival
 // order), each reading weighted by Tukey's biweight of its distance from their median.
 double lineEnd(const std::vector<double>& values) {
-  const double centre = median(values);
+  const double centre = medianOf(values);
   std::vector<double> deviations;
   deviations.reserve(values.size());
   for (double v : values) deviations.push_back(std::fabs(v - centre));
-  const double limit = kTukey * kMadToSigma * median(deviations);
+  const double limit = kTukey * kMadToSigma * medianOf(deviations);
   // Index t counted back from the newest (t = 0), so the line's intercept is its end.
   double n = 0.0, st = 0.0, sv = 0.0, stt = 0.0, stv = 0.0;
   const double newest = static_cast<double>(values.size() - 1);

@@ -11,6 +11,7 @@
 
 #include "oefmt/error.h"
 #include "oefmt/registration/phase_correlation.h"
+#include "oefmt/registration/robust_statistics.h"
 #include "oefmt/registration/warp.h"
 
 namespace oefmt {
@@ -39,8 +40,6 @@ constexpr int kFitPasses = 5;
 constexpr double kAxisScatterFloor = 0.02;
 // Below this shift [px] its direction, and with it "across the motion", is not known.
 constexpr double kMinAcrossShift = 1.0;
-// The median absolute deviation of a normal distribution, in its sigmas.
-constexpr double kMadToSigma = 1.4826;
 
 // Sub-pixel offset of a peak from its two neighbours: a Gaussian through the three where all are
 // positive (the shape of a windowed correlation peak), else a parabola.
@@ -61,12 +60,6 @@ int blockSizeFor(int image_size) {
                      std::to_string(kMinImageSize) + " px");
   }
   return image_size / (2 * kBlocksPerSide) * 2;
-}
-
-double median(std::vector<double> v) {
-  const auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), middle, v.end());
-  return *middle;
 }
 
 // R readings of one block's shift: rows of the fit's K unknowns and the values they should give.
@@ -114,7 +107,7 @@ RobustFit<K> robustFit(const std::vector<BlockReadings<K, R>>& blocks) {
       }
       residuals[i] = std::sqrt(squares);
     }
-    axis_scatter = std::max(kMadToSigma * median(residuals) / std::sqrt(double(R)), kAxisScatterFloor);
+    axis_scatter = std::max(kMadToSigma * medianOf(residuals) / std::sqrt(double(R)), kAxisScatterFloor);
     for (std::size_t i = 0; i < blocks.size(); ++i) {
       const double u = residuals[i] / (kTukeyScatters * std::sqrt(double(R)) * axis_scatter);
       weights[i] = u < 1.0 ? (1.0 - u * u) * (1.0 - u * u) : 0.0;
@@ -125,6 +118,19 @@ RobustFit<K> robustFit(const std::vector<BlockReadings<K, R>>& blocks) {
   fit.solved = true;
   fit.covariance = normal.inv(cv::DECOMP_CHOLESKY) * (axis_scatter * axis_scatter * readings / (readings - K));
   return fit;
+}
+
+// The motion a fit reads on top of `motion`: the turn and the zoom are its last two unknowns.
+template <int K>
+BlockMotion turnAndZoom(const RobustFit<K>& fit, const ImageSimilarity& motion, BlockMotion out) {
+  if (!fit.solved) return out;
+  out.valid = true;
+  out.rotation = motion.rotation - fit.unknowns[K - 2];
+  out.log_zoom = motion.log_zoom + fit.unknowns[K - 1];
+  out.rotation_sigma = std::sqrt(std::max(fit.covariance(K - 2, K - 2), 0.0));
+  out.log_zoom_sigma = std::sqrt(std::max(fit.covariance(K - 1, K - 1), 0.0));
+  out.blocks = fit.blocks;
+  return out;
 }
 
 }  // namespace
@@ -259,7 +265,6 @@ BlockMotion BlockMotionReader::fitShifts(const ImageSimilarity& motion, const cv
   out.tried = tried_;
   out.blocks = static_cast<int>(shifts_.size());
   out.across_motion = across != nullptr;
-  double turn = 0.0, zoom = 0.0;
   if (across == nullptr) {
     std::vector<BlockReadings<4, 2>> readings;
     readings.reserve(shifts_.size());
@@ -267,35 +272,18 @@ BlockMotion BlockMotionReader::fitShifts(const ImageSimilarity& motion, const cv
       const cv::Point2d& p = b.position;
       readings.push_back({{cv::Vec4d(1.0, 0.0, -p.y, p.x), cv::Vec4d(0.0, 1.0, p.x, p.y)}, {b.shift.x, b.shift.y}});
     }
-    const RobustFit<4> fit = robustFit(readings);
-    if (!fit.solved) return out;
-    turn = fit.unknowns[2];
-    zoom = fit.unknowns[3];
-    out.rotation_sigma = std::sqrt(std::max(fit.covariance(2, 2), 0.0));
-    out.log_zoom_sigma = std::sqrt(std::max(fit.covariance(3, 3), 0.0));
-    out.blocks = fit.blocks;
-  } else {
-    // n . r = t_n + w (n . J p) + e (n . p): the shift along the motion, where depth adds its
-    // own, is not read.
-    const cv::Point2d n = *across;
-    std::vector<BlockReadings<3, 1>> readings;
-    readings.reserve(shifts_.size());
-    for (const BlockShift& b : shifts_) {
-      const cv::Point2d& p = b.position;
-      readings.push_back({{cv::Vec3d(1.0, n.y * p.x - n.x * p.y, n.dot(p))}, {n.dot(b.shift)}});
-    }
-    const RobustFit<3> fit = robustFit(readings);
-    if (!fit.solved) return out;
-    turn = fit.unknowns[1];
-    zoom = fit.unknowns[2];
-    out.rotation_sigma = std::sqrt(std::max(fit.covariance(1, 1), 0.0));
-    out.log_zoom_sigma = std::sqrt(std::max(fit.covariance(2, 2), 0.0));
-    out.blocks = fit.blocks;
+    return turnAndZoom(robustFit(readings), motion, out);
   }
-  out.valid = true;
-  out.rotation = motion.rotation - turn;
-  out.log_zoom = motion.log_zoom + zoom;
-  return out;
+  // n . r = t_n + w (n . J p) + e (n . p): the shift along the motion, where depth adds its own,
+  // is not read.
+  const cv::Point2d n = *across;
+  std::vector<BlockReadings<3, 1>> readings;
+  readings.reserve(shifts_.size());
+  for (const BlockShift& b : shifts_) {
+    const cv::Point2d& p = b.position;
+    readings.push_back({{cv::Vec3d(1.0, n.y * p.x - n.x * p.y, n.dot(p))}, {n.dot(b.shift)}});
+  }
+  return turnAndZoom(robustFit(readings), motion, out);
 }
 
 }  // namespace oefmt

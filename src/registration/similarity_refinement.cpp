@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "oefmt/error.h"
+#include "oefmt/registration/robust_statistics.h"
 #include "oefmt/registration/warp.h"
 
 namespace oefmt {
@@ -152,10 +153,10 @@ double robustScale(std::vector<float>& magnitudes) {
   std::nth_element(magnitudes.begin(), quartile, magnitudes.end());
   if (*quartile > 0.0f) return *quartile / kQuartileOfUnitGaussian;
   // A quarter of the pixels fit exactly (flat texture in a noiseless frame): they tell no scale,
-  // the median does (1.4826: its factor for a Gaussian's magnitude).
+  // the median does.
   auto middle = magnitudes.begin() + magnitudes.size() / 2;
   std::nth_element(quartile, middle, magnitudes.end());
-  return 1.4826 * *middle;
+  return kMadToSigma * *middle;
 }
 
 // Tukey's biweight loss of one residual at the threshold `limit`: 0 for a perfect fit, 1 beyond.
