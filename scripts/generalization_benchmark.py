@@ -322,6 +322,9 @@ def main():
                         help="the seeds of --subset periodic (default %(default)s; the corpus and "
                         "holdout use seeds up to 60)")
     parser.add_argument("--flights", help="comma-separated flight names (instead of --subset)")
+    parser.add_argument("--known-altitude", action="store_true",
+                        help="give every mode each flight's true initial altitude (--altitude), as a "
+                        "user who knows it would for metric output; by default only the spins get it")
     parser.add_argument("--rangefinder", action="store_true",
                         help="the same flights with a downward rangefinder (range.txt, read by "
                         "oefmt_offline for the altitude), rendered beside the others")
@@ -378,7 +381,8 @@ def main():
         row = {"name": entry["name"], "what": entry["what"], "altitude": altitude}
         for mode in modes:
             trajectory, diagnostics, wall, cpu = estimate(tools, folder, mode, args.config, out_dir,
-                                                          altitude if entry["spin"] else None)
+                                                          altitude if entry["spin"] or args.known_altitude
+                                                          else None)
             figures = evaluate(tools, trajectory, truth, entry["spin"])
             # A spin travels no distance: its drift is the largest position error as a share of
             # the altitude instead.

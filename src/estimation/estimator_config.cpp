@@ -176,15 +176,18 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
                       "between an aliased correlation peak and the loop); 0 = off"),
       numberParameter("tracking.max_acceleration", t.max_acceleration, "m/s^2", closedRange(0.01, 1000.0),
                       "largest acceleration of the vehicle: how far the next translation peak may lie "
-                      "from the motion so far (fx a dt^2 / altitude px); a weaker peak inside that "
-                      "window is accepted, an alias outside it is not taken at full confidence"),
+                      "from the motion so far (fx a dt^2 / d px, d = tracking.assumed_altitude or the "
+                      "altitude if lower); a weaker peak inside that window is accepted, an alias "
+                      "outside it is not taken at full confidence"),
       numberParameter("tracking.max_yaw_rate", t.max_yaw_rate, "rad/s", closedRange(0.01, 1000.0),
                       "largest yaw rate of the vehicle: a pair's rotation beyond it over the frames' "
                       "interval is not taken, and below a quarter turn it decides the half-turn "
                       "ambiguity of the rotation (a texture alike when turned cannot flip the heading)"),
       numberParameter("tracking.assumed_altitude", t.assumed_altitude, "m", closedRange(0.01, 1e5),
-                      "distance to the scene the acceleration window assumes when the altitude is "
-                      "unknown: low on purpose, which makes the window wide rather than wrong"),
+                      "distance to the nearest scene content the acceleration window allows for, "
+                      "scaled as the vehicle climbs (the known altitude where that is lower): low on "
+                      "purpose, as roofs and walls stand nearer than the ground and the window also "
+                      "holds the prediction's own errors"),
 
       numberParameter("uncertainty.rotation_scale", u.rotation_scale, "", closedRange(1e-4, 100.0),
                       "rotation error per rotation peak width"),

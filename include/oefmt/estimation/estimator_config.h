@@ -68,10 +68,10 @@ struct TrackingConfig {
   double motion_prior_sigma = 0.3;
   /// Largest acceleration of the vehicle [m/s^2]. The motion so far predicts where the next
   /// pair's translation peak lies; the window around that prediction is how far the vehicle can
-  /// depart from it between two frames (fx a dt^2 / altitude pixels). A weaker peak inside the
-  /// window is accepted where a peak anywhere in the image would not be, and the highest peak
-  /// outside the window and off the direction of motion (a repetitive texture's alias) is not
-  /// taken at full confidence.
+  /// depart from it between two frames (fx a dt^2 / d pixels, d: assumed_altitude or the known
+  /// altitude if lower). A weaker peak inside the window is accepted where a peak anywhere in the
+  /// image would not be, and the highest peak outside the window and off the direction of motion
+  /// (a repetitive texture's alias) is not taken at full confidence.
   double max_acceleration = 10.0;
   /// Largest yaw rate of the vehicle [rad/s] (a multirotor's fastest commanded yaw, about
   /// 200 deg/s). A pair's rotation beyond it over the frames' interval is not taken, and where it
@@ -79,8 +79,9 @@ struct TrackingConfig {
   /// the smaller turn: a texture that looks the same turned by half a turn (bricks, tiles, a
   /// lattice) cannot flip the heading.
   double max_yaw_rate = 3.5;
-  /// Distance to the scene [m] the acceleration window assumes when the altitude is unknown:
-  /// low on purpose, which makes the window wide rather than wrong.
+  /// Distance [m] to the nearest scene content the acceleration window allows for, scaled as the
+  /// vehicle climbs; the known altitude where that is lower. Low on purpose: roofs and walls stand
+  /// nearer than the ground, and the window also holds the prediction's own errors.
   double assumed_altitude = 5.0;
 
   void validate() const;
