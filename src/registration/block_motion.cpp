@@ -19,10 +19,9 @@ namespace {
 
 // The blocks' side is the frame's over kBlocksPerSide (seven of them fit a side within the
 // margin [px] kept from the frame's edge, where the apodization and the sampling's interpolation
-// leave too little texture); frames under kMinImageSize give blocks too small to correlate.
+// leave too little texture).
 constexpr int kBlocksPerSide = 8;
 constexpr int kEdgeMargin = 8;
-constexpr int kMinImageSize = 64;
 // A block follows the pair's motion when its remaining shift lies within this many pixels: the
 // similarity it is sampled at is within a pixel or two at the image's edge, while another depth
 // layer or a periodic texture's alias lies further off.
@@ -55,9 +54,9 @@ double peakOffset(float before, float at, float after) {
 
 // The side of the blocks for frames of `image_size` pixels: an eighth, rounded down to even.
 int blockSizeFor(int image_size) {
-  if (image_size < kMinImageSize) {
+  if (image_size < BlockMotionReader::kMinImageSize) {
     throw InputError("BlockMotionReader: frames of " + std::to_string(image_size) + " px are under " +
-                     std::to_string(kMinImageSize) + " px");
+                     std::to_string(BlockMotionReader::kMinImageSize) + " px");
   }
   return image_size / (2 * kBlocksPerSide) * 2;
 }
@@ -242,7 +241,6 @@ BlockMotion BlockMotionReader::read(const cv::Mat1f& older, const cv::Mat1f& new
       shifts_.push_back({{x0 + half - centre, y0 + half - centre}, shift});
     }
   }
-  tried_ = out.tried;
   out.blocks = static_cast<int>(shifts_.size());
   if (out.blocks < kMinBlocks) return out;
   const double length = cv::norm(motion.translation);
@@ -250,19 +248,21 @@ BlockMotion BlockMotionReader::read(const cv::Mat1f& older, const cv::Mat1f& new
   if (fit == BlockFit::kAcrossMotion && !across_known) return out;
   const cv::Point2d across = across_known ? cv::Point2d(-motion.translation.y, motion.translation.x) / length
                                           : cv::Point2d();
-  if (fit == BlockFit::kBoth || !across_known) return fitShifts(motion, nullptr);
-  if (fit == BlockFit::kAcrossMotion) return fitShifts(motion, &across);
-  const BlockMotion both = fitShifts(motion, nullptr), across_only = fitShifts(motion, &across);
+  if (fit == BlockFit::kBoth || !across_known) return fitShifts(motion, nullptr, out.tried);
+  if (fit == BlockFit::kAcrossMotion) return fitShifts(motion, &across, out.tried);
+  const BlockMotion both = fitShifts(motion, nullptr, out.tried);
+  const BlockMotion across_only = fitShifts(motion, &across, out.tried);
   if (!across_only.valid) return both;
   if (!both.valid) return across_only;
   return across_only.rotation_sigma < both.rotation_sigma ? across_only : both;
 }
 
-BlockMotion BlockMotionReader::fitShifts(const ImageSimilarity& motion, const cv::Point2d* across) {
+BlockMotion BlockMotionReader::fitShifts(const ImageSimilarity& motion, const cv::Point2d* across,
+                                         int tried) const {
   // The block at p shifted by r: r = t + w J p + e p, J p = (-p_y, p_x), for the newer frame
   // sampled at the motion; its true motion is then turned by -w and zoomed by -e on top of it.
   BlockMotion out;
-  out.tried = tried_;
+  out.tried = tried;
   out.blocks = static_cast<int>(shifts_.size());
   out.across_motion = across != nullptr;
   if (across == nullptr) {

@@ -107,10 +107,10 @@ constexpr double kLossEvidence = 2.0;
 // many pixels had not settled: a fiftieth of a pixel is below what the images' interpolation can
 // tell, and where one layer fits, the fourth step moves it far less.
 constexpr double kSettledEdgeShift = 0.02;
-// A sigma of the blocks' rotation (BlockMotion) in sigmas of an unsettled refinement's (its normal
-// equations' widened by its last step): 90 % of the errors lie within 2.5 of the blocks' sigmas
-// and 4.2 of the refinement's on the calibration flights of scripts/calibrate_rotation_sigma.py
-// (70 unsettled pairs), hence 0.6.
+// A sigma of the blocks' rotation (BlockMotion) in sigmas of a settled refinement's, the unit that
+// uncertainty.refined_rotation_scale calibrates: on the calibration flights of
+// scripts/calibrate_rotation_sigma.py 90 % of the blocks' errors lie within 4.3 of their sigmas
+// (45 pairs) and 90 % of the settled refinement's within 3.5 of its, hence 0.6 x 4.3 / 3.5.
 constexpr double kBlockSigmaInRefinementSigmas = 0.74;
 // otherLayerShifts: how many peaks, and how near the followed shift a peak is the same layer.
 constexpr int kOtherLayers = 4;
@@ -250,7 +250,9 @@ Registrar::Registrar(std::shared_ptr<const SpectralContext> context)
     : context_(std::move(context)),
       builder_(context_),
       rotation_zoom_candidates_(context_->config().rotation_zoom_candidates) {
-  if (context_->size() >= 64) blocks_.emplace(context_->size(), context_->config().fft_planning);
+  if (context_->size() >= BlockMotionReader::kMinImageSize) {
+    blocks_.emplace(context_->size(), context_->config().fft_planning);
+  }
 }
 
 FrameSpectra Registrar::analyse(const cv::Mat& image, ChannelOrder order) {

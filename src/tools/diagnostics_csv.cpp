@@ -62,7 +62,7 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
       {"sigma_theta_rad", "rad", "sigma of theta_rad from the peak's width",
        [](const Estimate& e) { return format("%.8f", pair12(e).rotation_sigma); }},
       {"refined_theta_rad", "rad",
-       "pair 1-2's rotation as the zoom refinement read it, weighed with the blocks' reading where the "
+       "pair 1-2's rotation as the zoom refinement read it, or as the image blocks read it where the "
        "refinement had not settled (0: not refined)",
        [](const Estimate& e) { return format("%.8f", pair12(e).refined_rotation); }},
       {"sigma_refined_theta_rad", "rad",
@@ -70,7 +70,7 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        "they were read (0: none; uncertainty.refined_rotation_scale calibrates it)",
        [](const Estimate& e) { return format("%.8f", pair12(e).refined_rotation_sigma); }},
       {"motion_blocks", "",
-       "image blocks whose shifts read pair 1-2's rotation beside a zoom refinement that had not settled "
+       "image blocks whose shifts read pair 1-2's rotation where its zoom refinement had not settled "
        "(0: the refinement settled, or no block followed the pair)",
        [](const Estimate& e) { return format("%d", pair12(e).motion_blocks); }},
       {"sigma_log_zoom", "", "sigma of ln(zoom) from the peak's width",

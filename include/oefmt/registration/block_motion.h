@@ -56,8 +56,11 @@ enum class BlockFit {
 /// Holds scratch buffers and an FFT plan: one reader per thread.
 class BlockMotionReader {
  public:
+  /// Frames under this many pixels give blocks too small to correlate.
+  static constexpr int kMinImageSize = 64;
+
   /// Blocks of image_size / 8 pixels, rounded down to even. Throws InputError for frames under
-  /// 64 pixels.
+  /// kMinImageSize pixels.
   BlockMotionReader(int image_size, FftPlanning planning);
 
   /// `older` and `newer` are N x N grey frames; `motion` the pair's similarity to within a pixel
@@ -74,8 +77,8 @@ class BlockMotionReader {
     cv::Point2d shift;     // remaining shift of the newer frame's block [px]
   };
   // The robust fit of the blocks' shifts (both components, or those across `across`, a unit
-  // vector), on top of `motion`.
-  BlockMotion fitShifts(const ImageSimilarity& motion, const cv::Point2d* across);
+  // vector), on top of `motion`; `tried`: the blocks inside both frames.
+  BlockMotion fitShifts(const ImageSimilarity& motion, const cv::Point2d* across, int tried) const;
   // The remaining shift of one block and whether its correlation peak stands clear.
   // `older_to_newer`: where the pair's similarity puts an older pixel in the newer frame.
   bool blockShift(const cv::Mat1f& older, const cv::Mat1f& newer, const cv::Matx23d& older_to_newer,
@@ -88,7 +91,6 @@ class BlockMotionReader {
   cv::Mat1f surface_;  // a view of newer_spectrum_ (in-place FFTs)
   cv::Mat2f older_spectrum_, newer_spectrum_;
   std::vector<BlockShift> shifts_;
-  int tried_ = 0;  // blocks inside both frames, of the last read
 };
 
 }  // namespace oefmt

@@ -112,8 +112,8 @@ struct PairRegistration {
   /// The refinement had not settled (its last step still moved the image's edge by more than a
   /// fiftieth of a pixel): it was heading for several layers' compromise, or along a valley of a
   /// striped texture. The blocks that follow the pair's shift (BlockMotionReader) read the
-  /// rotation beside it: refined_rotation and its sigma weigh both readings, and this counts the
-  /// blocks (0: the refinement's own reading, or none).
+  /// rotation instead: refined_rotation and its sigma are theirs, and this counts the blocks (0:
+  /// the refinement's own reading, or none).
   int motion_blocks = 0;
   double stretch_a = 0.0;
   double stretch_b = 0.0;
@@ -300,7 +300,7 @@ class Registrar {
 
   std::shared_ptr<const SpectralContext> context_;
   SpectraBuilder builder_;
-  std::optional<BlockMotionReader> blocks_;  // frames of at least 64 px
+  std::optional<BlockMotionReader> blocks_;  // frames of at least BlockMotionReader::kMinImageSize
   bool block_reading_ = true;
   // Scratch, reused across calls.
   cv::Mat2f cross_power_, small_spectrum_, rotation_zoom_power_;
