@@ -682,7 +682,19 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   est.registration_ms += msSince(t);
   const PairRegistration& reg12 = est.registration12;
   const PairRegistration& reg02 = est.registration02;
-  const bool usable02 = with02 && reg02.usable();
+  // Pair 0-2's translation spans twice the motion: at low overlap, or over a periodic texture
+  // whose aliases stand as high, it fails where pair 1-2's registers. Its rotation/zoom peak reads
+  // the magnitude spectra, which do not depend on the translation, and still closes the loop's
+  // rotation. Nothing confirmed that peak, as a registered translation would have: it is taken
+  // only within the gates of the rates' recent deviations, like pair 1-2's own turn and zoom
+  // (consistentRates), and its rotation alone: such a pair's refined zoom erred over the corpus
+  // several times as much as a registered pair's, its rotation about as little (doc/method.md).
+  const bool rotation_only02 =
+      with02 && !reg02.usable() && reg02.rotation_zoom_only && prior02 &&
+      turn_deviations.withinGate(wrapToPi(reg02.rotation - prior02->rotation)) &&
+      zoom_deviations.withinGate(std::log(reg02.zoom) - prior02->log_zoom);
+  est.rotation_only02 = rotation_only02;
+  const bool usable02 = with02 && (reg02.usable() || rotation_only02);
   const double shift_per_bin = registrar.shiftPerBin();
   const double log_zoom_per_bin = registrar.logZoomPerBin();
   const int gap12 = est.frame_gap;
@@ -703,7 +715,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
     est.pmt12 = matchStretch(translation01, reg12.translation_energy,
                              detail::stretchOptions(mc, double(gap12) / gap01, mc.stretch_key_12,
                                                     reference_bin));
-    if (usable02) {
+    if (usable02 && !rotation_only02) {
       est.pmt02 = matchStretch(translation01, reg02.translation_energy,
                                detail::stretchOptions(mc, double(gap02) / gap01, mc.stretch_key_02,
                                                       reference_bin));
@@ -711,7 +723,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   }
   if (!zoom01.empty()) {
     est.pms12 = matchShift(zoom01, reg12.zoom_energy, detail::shiftOptions(mc));
-    if (usable02) est.pms02 = matchShift(zoom01, reg02.zoom_energy, detail::shiftOptions(mc));
+    if (usable02 && !rotation_only02) est.pms02 = matchShift(zoom01, reg02.zoom_energy, detail::shiftOptions(mc));
     // A shift puts the pair's zoom at S01's plus the shift; outside the window the motion so
     // far predicts for the pair, it matched another feature of the vectors.
     const auto implausible = [&](const MatchResult& pms, const std::optional<RegistrationPrior>& prior) {
@@ -748,9 +760,15 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   // a seventh. Pair 1-2's lies only the change of the zoom rate away, about none in steady flight.
   // est.pms02 stays a diagnostic.
   PairMotion initial02;
-  const PairObservations obs02 = detail::observe(
+  PairObservations obs02 = detail::observe(
       reg02, detail::calibrated(reg02, config.uncertainty), est.pmt02, MatchResult{}, ref, config,
       shift_per_bin, log_zoom_per_bin, double(gap02) / gap01, prior02 ? &*prior02 : nullptr, initial02);
+  if (rotation_only02) {
+    obs02.log_zoom.clear();
+    obs02.translation_use = PairObservations::TranslationUse::kNone;
+    obs02.shift.clear();
+    obs02.translation_priors.clear();
+  }
   est.translation_use02 = obs02.translation_use;
   t = Clock::now();
   est.loop = optimizer.solve(motion01, obs12, obs02, initial12, initial02);
@@ -760,6 +778,17 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
     // elsewhere in the loop pulled a loosely measured value): the measurement stands.
     est.loop.status = OptimizerStatus::kFallback;
     est.loop.message = "rotation or zoom outside the predicted window";
+  }
+  if (rotation_only02) {
+    // The loop closed the turn alone: pair 1-2 keeps its own zoom and length, as without a loop.
+    // Otherwise the pair's other readings (its PMS zoom, the layers' lengths), which nothing
+    // outside the pair weighs where pair 0-2 has no zoom or translation, would settle them.
+    PairMotion step = initial12;
+    if (est.loop.status == OptimizerStatus::kConverged) {
+      step.rotation = est.loop.pair12.rotation;
+      step.rotation_sigma = est.loop.pair12.rotation_sigma;
+    }
+    return followLayer(step);
   }
   if (est.loop.status != OptimizerStatus::kConverged) {
     est.degraded = true;
@@ -1076,6 +1105,8 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     bool with02 = config_.mode == EstimatorMode::kOefmt && s.f0 && s.have01 &&
                         s.shiftInReach(s.motion01.translation * (double(s.gap01 + est.frame_gap) / s.gap01));
     s.prior02 = with02 ? s.predictedPair(est.frame_gap, seconds12, &s.motion01) : std::nullopt;
+    // Where pair 0-2's translation fails, its rotation may still close the loop (oefmtStep).
+    if (s.prior02) s.prior02->rotation_zoom_alone = true;
     // Levelled frames: the zooms are corrected for the tilt the attitude source left (zero until
     // the readings tell it). A frame levelled or not unlike the one before starts the readings
     // over: they describe another view.
@@ -1115,6 +1146,9 @@ std::optional<Estimate> Estimator::process(FrameSpectra spectra, double stamp, d
     if (keep_surfaces_) surfaces = &est.surfaces12.emplace();
     s.prior12 = s.predictedPair(est.frame_gap, seconds12, nullptr);
     if (s.prior12) {
+      // A pair 1-2 whose translation fails may still be carried by its layers (corroboratedStep):
+      // with the rotation and zoom refined from the predicted translation, not the surface peak's.
+      s.prior12->rotation_zoom_alone = true;
       s.prior12->translation_ambiguous = s.ambiguous_motion;
       s.prior12->doubt_log_share = s.doubt_log_share;
     }

@@ -393,6 +393,9 @@ RateDeviations::RateDeviations(std::size_t frames, std::size_t support, double g
 bool RateDeviations::beyondGate(double deviation) const {
   return deviations_.size() >= support_ && std::fabs(deviation) > gate_ * spread();
 }
+bool RateDeviations::withinGate(double deviation) const {
+  return deviations_.size() >= support_ && std::fabs(deviation) <= gate_ * spread();
+}
 bool RateDeviations::outlier(double deviation, bool may_change_rate) {
   if (!may_change_rate && beyondGate(deviation)) return true;
   if (!last_outlier_ && beyondGate(deviation)) {

@@ -70,6 +70,8 @@ class RateDeviations {
   /// Whether `deviation` lies beyond the gate, judged without remembering it (false until the
   /// support is known).
   bool beyondGate(double deviation) const;
+  /// Whether enough deviations are remembered to judge one, and `deviation` lies within the gate.
+  bool withinGate(double deviation) const;
   /// The remembered deviations' spread as a normal sigma (at least the floor).
   double spread() const;
   void clear();

@@ -318,9 +318,28 @@ PairRegistration Registrar::registerPair(const FrameSpectra& older, const FrameS
     if (trial.peak_confidence > result.peak_confidence) {
       result = std::move(trial);
       if (surfaces != nullptr) *surfaces = std::move(trial_surfaces);
+    } else if (prior->rotation_zoom_alone && trial.status != RegistrationStatus::kOk) {
+      refineRotationZoomAlone(older, newer, *prior, result);
     }
   }
   return result;
+}
+
+void Registrar::refineRotationZoomAlone(const FrameSpectra& older, const FrameSpectra& newer,
+                                        const RegistrationPrior& prior, PairRegistration& result) {
+  if (!context_->config().refine_zoom || !(prior.translation_radius > 0.0) ||
+      !(result.rotation_zoom_confidence >= context_->config().min_confidence)) {
+    return;
+  }
+  // The refinement starts from the translation the motion so far predicts unless the measured
+  // one lies in its window: the highest peak elsewhere is an alias or another pair's match, and
+  // the intensities pull the similarity only within a few pixels of where it starts.
+  const cv::Point2d measured = result.translation;
+  if (!(cv::norm(measured - prior.translation) <= prior.translation_radius)) result.translation = prior.translation;
+  refineZoom(older, newer, *context_, logZoomPerBin(), plane_tilt_, &prior,
+             blocks_ && block_reading_ ? &*blocks_ : nullptr, result);
+  result.rotation_zoom_only = result.zoom_refined;
+  result.translation = measured;
 }
 
 cv::Point2d Registrar::windowCentre(const RegistrationPrior& window) const {
@@ -407,9 +426,8 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
         method == RegistrationMethod::kEnergyVectors ? polar_.clone() : cv::Mat1f();
     surfaces->translation_polar_first_row = ((polar_first_row_ % n) + n) % n;
   }
-  result.peak_confidence =
-      std::min(confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood),
-               translation_confidence);
+  result.rotation_zoom_confidence = confidenceFrom(psr_rotation_zoom, kRotationZoomPsrFloor, kRotationZoomPsrGood);
+  result.peak_confidence = std::min(result.rotation_zoom_confidence, translation_confidence);
   // A rotation beyond the vehicle's reach, or a rotation or zoom the motion so far rules out
   // (another peak of the whole surface, a half turn the low-resolution test chose), is not
   // taken, however well its translation matched: a repetitive pattern matches itself turned by
@@ -417,6 +435,7 @@ void Registrar::registerOnce(const FrameSpectra& older, const FrameSpectra& newe
   if (std::fabs(result.rotation) > max_rotation_ ||
       (prior != nullptr && !prior->contains(result.rotation, std::log(result.zoom)))) {
     result.rotation_zoom_implausible = true;
+    result.rotation_zoom_confidence = 0.0;
     result.peak_confidence = 0.0;
   }
   result.confidence = result.peak_confidence * result.uniqueness();

@@ -129,6 +129,10 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        [](const Estimate& e) { return format("%.6f", e.plane_tilt.y); }},
       {"optimizer_status", "", "the three-frame loop: converged, fallback (the measurements stand) or skipped",
        [](const Estimate& e) { return std::string(toString(e.loop.status)); }},
+      {"rotation_only02", "",
+       "1 when pair 0-2's translation did not register and the loop took its rotation alone (its "
+       "rotation and zoom peak within the gates of the rates' recent deviations)",
+       [](const Estimate& e) { return format("%d", e.rotation_only02 ? 1 : 0); }},
       {"optimizer_iterations", "", "Levenberg-Marquardt iterations over all starting points",
        [](const Estimate& e) { return format("%d", e.loop.iterations); }},
       {"cost_initial", "", "the loop's cost at the winning start",

@@ -80,6 +80,17 @@ const cv::Mat1f& flightTexture() {
   return texture;
 }
 
+sim::FlightOptions tiledFigureEight() {
+  sim::FlightOptions options;
+  options.track.shape = sim::TrackShape::kEight;
+  options.track.length = 880.0;  // oefmt_simulate's figure-8
+  options.track.frames = 300;
+  options.texture_styles = {sim::TextureStyle::kTiles};
+  options.walls = true;
+  options.seed = 22;
+  return options;
+}
+
 sim::FlightOptions weakTextureFlight(sim::TrackShape shape, unsigned seed) {
   sim::FlightOptions options;
   options.track.shape = shape;

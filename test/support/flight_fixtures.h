@@ -59,6 +59,10 @@ const cv::Mat1f& flightTexture();
 /// levels and a brightness flicker of +-10 % between frames, over the simulator's default scene.
 sim::FlightOptions weakTextureFlight(sim::TrackShape shape, unsigned seed);
 
+/// The generalization corpus's `eight-tiles`: oefmt_simulate's figure-8 over tiles on every layer,
+/// walls in view, consecutive frames overlapping 78 % (seed 22).
+sim::FlightOptions tiledFigureEight();
+
 /// The simulator's plan for `options`, cut to its first `frames` frames.
 sim::FlightPlan plannedFlight(const sim::FlightOptions& options, int frames);
 

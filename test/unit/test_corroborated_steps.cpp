@@ -113,13 +113,7 @@ TEST(CorroboratedSteps, AFollowedLayerFarBelowTheHighestOneStillVouches) {
 // length, and the step takes it in the predicted direction (Estimator: corroborated along the
 // prediction). Without that reading the frame was not tracked.
 TEST(CorroboratedSteps, AnAliasOffTheMotionLeavesTheLayersAlongThePredictedDirectionToVouch) {
-  sim::FlightOptions options;
-  options.track.shape = sim::TrackShape::kEight;
-  options.track.length = 880.0;  // oefmt_simulate's figure-8
-  options.track.frames = 300;
-  options.texture_styles = {sim::TextureStyle::kTiles};
-  options.walls = true;
-  options.seed = 22;
+  const sim::FlightOptions options = test::tiledFigureEight();
   const sim::FlightPlan plan = test::plannedFlight(options, 80);
   const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
   Estimator estimator(test::simulatedFlightConfig(plan));

@@ -84,6 +84,9 @@ struct Estimate {
   /// another depth layer's or an alias, by the PMT prediction).
   PairObservations::TranslationUse translation_use12 = PairObservations::TranslationUse::kVector;
   PairObservations::TranslationUse translation_use02 = PairObservations::TranslationUse::kVector;
+  /// Pair 0-2's translation did not register but its rotation/zoom peak did, within the rates'
+  /// gates: the loop took its rotation alone (PairRegistration::rotation_zoom_only).
+  bool rotation_only02 = false;
 
   PairMotion measured12;  ///< pair 1-2 as measured (calibrated sigmas), before the optimizer
   PairMotion step;        ///< pair 1-2 as integrated into the pose

@@ -99,6 +99,17 @@ struct PairRegistration {
   double uniqueness() const;
   /// The rotation or zoom lay outside the prior's window: not confident, whatever the peaks.
   bool rotation_zoom_implausible = false;
+  /// The rotation/zoom peak's own confidence, 0 to 1 (its peak-to-sidelobe ratio; 0 where it lay
+  /// outside the prior's window or beyond the vehicle's turn). peak_confidence is the smaller of
+  /// this and the translation's.
+  double rotation_zoom_confidence = 0.0;
+  /// The translation did not register (status kLowConfidence) but the rotation/zoom peak did, and
+  /// rotation, zoom and refined_rotation were refined on the intensities starting from the prior's
+  /// translation: only where the prior asked for it (RegistrationPrior::rotation_zoom_alone). The
+  /// magnitude spectra do not depend on the translation, so the two readings stand apart; but
+  /// where the translation fails nothing confirms the rotation and zoom either, and the caller
+  /// judges them against the motion so far.
+  bool rotation_zoom_only = false;
   /// The zoom was refined on the intensities (registration.refine_zoom), with the plane tilt
   /// set (Registrar::setPlaneTilt) along with the area-preserving stretch [a b; b -a] of B's
   /// content (oefmt/registration/plane_tilt.h; zero otherwise).
@@ -188,6 +199,10 @@ struct RegistrationPrior {
   /// pairs since the doubted start, each within a factor of kMaxDoubtShare either way. Above 0
   /// where the prediction's peak stood above the other readings more than it fell behind them.
   double doubt_log_share = 0.0;
+  /// Where the translation does not register but the window's rotation/zoom peak does, refine
+  /// that rotation and zoom from the predicted translation (translation_radius > 0) and report
+  /// them (PairRegistration::rotation_zoom_only) rather than the prediction's own.
+  bool rotation_zoom_alone = false;
 };
 
 /// The shifts [px] of a registered pair's other depth layers, which the zoom refinement tests its
@@ -275,6 +290,11 @@ class Registrar {
   SurfacePeak windowPeak(const RegistrationPrior& window, cv::Point exclude = {-10, -10}) const;
   // That Gaussian weight of a surface position.
   double windowWeight(const RegistrationPrior& window, cv::Point peak) const;
+  // RegistrationPrior::rotation_zoom_alone: a result whose translation did not register takes
+  // its rotation and zoom refined from the predicted translation, where its rotation/zoom peak
+  // was confident (PairRegistration::rotation_zoom_only).
+  void refineRotationZoomAlone(const FrameSpectra& older, const FrameSpectra& newer,
+                               const RegistrationPrior& prior, PairRegistration& result);
   // The translation alone, with the prior's rotation and zoom.
   void registerOnPrior(const FrameSpectra& older, const FrameSpectra& newer, RegistrationMethod method,
                        const RegistrationPrior& prior, PairRegistration& result,
