@@ -694,7 +694,8 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
       turn_deviations.withinGate(wrapToPi(reg02.rotation - prior02->rotation)) &&
       zoom_deviations.withinGate(std::log(reg02.zoom) - prior02->log_zoom);
   est.rotation_only02 = rotation_only02;
-  const bool usable02 = with02 && (reg02.usable() || rotation_only02);
+  const bool registered02 = with02 && reg02.usable();
+  const bool usable02 = registered02 || rotation_only02;
   const double shift_per_bin = registrar.shiftPerBin();
   const double log_zoom_per_bin = registrar.logZoomPerBin();
   const int gap12 = est.frame_gap;
@@ -715,7 +716,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
     est.pmt12 = matchStretch(translation01, reg12.translation_energy,
                              detail::stretchOptions(mc, double(gap12) / gap01, mc.stretch_key_12,
                                                     reference_bin));
-    if (usable02 && !rotation_only02) {
+    if (registered02) {
       est.pmt02 = matchStretch(translation01, reg02.translation_energy,
                                detail::stretchOptions(mc, double(gap02) / gap01, mc.stretch_key_02,
                                                       reference_bin));
@@ -723,7 +724,7 @@ PairMotion Estimator::State::oefmtStep(const WindowFrame& frame, Estimate& est, 
   }
   if (!zoom01.empty()) {
     est.pms12 = matchShift(zoom01, reg12.zoom_energy, detail::shiftOptions(mc));
-    if (usable02 && !rotation_only02) est.pms02 = matchShift(zoom01, reg02.zoom_energy, detail::shiftOptions(mc));
+    if (registered02) est.pms02 = matchShift(zoom01, reg02.zoom_energy, detail::shiftOptions(mc));
     // A shift puts the pair's zoom at S01's plus the shift; outside the window the motion so
     // far predicts for the pair, it matched another feature of the vectors.
     const auto implausible = [&](const MatchResult& pms, const std::optional<RegistrationPrior>& prior) {

@@ -11,7 +11,6 @@
 namespace oefmt {
 namespace {
 
-// Gaussian sigma per median absolute deviation.
 // Tukey's biweight threshold in robust sigmas (95 % efficiency on Gaussian readings): readings
 // far from the median (parallax) count for nothing, and a reading's weight falls smoothly on the
 // way there, so that a tiny change of one reading never flips the line.
