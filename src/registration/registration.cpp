@@ -109,7 +109,7 @@ constexpr double kLossEvidence = 2.0;
 constexpr double kSettledEdgeShift = 0.02;
 // A sigma of the blocks' rotation (BlockMotion) in sigmas of a settled refinement's, the unit that
 // uncertainty.refined_rotation_scale calibrates: on the calibration flights of
-// scripts/calibrate_rotation_sigma.py 90 % of the blocks' errors lie within 4.3 of their sigmas
+// scripts/calibrate_refined_sigmas.py 90 % of the blocks' errors lie within 4.3 of their sigmas
 // (45 pairs) and 90 % of the settled refinement's within 3.5 of its, hence 0.6 x 4.3 / 3.5.
 constexpr double kBlockSigmaInRefinementSigmas = 0.74;
 // otherLayerShifts: how many peaks, and how near the followed shift a peak is the same layer.
@@ -194,6 +194,7 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   }
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;
+  result.refined_log_zoom_sigma = refined.log_zoom_sigma;
   // An unsettled refinement was still on its way when it stopped: towards several layers'
   // compromise (walls in view, whose shift grows with their height), or along the valley of a
   // striped texture, where a turn and a zoom together slide the stripes along themselves. Its

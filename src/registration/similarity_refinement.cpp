@@ -648,10 +648,11 @@ SimilarityRefinement refineSimilarity(const RefinementImage& older, const Refine
     Vector step;
     if (!cv::solve(normal, rhs, step, cv::DECOMP_CHOLESKY)) return out;
     if (iteration + 1 == iterations) {
-      // How closely the last step's pixels pin the rotation: sigma^2 (J^T W J)^-1, the weights
+      // How closely the last step's pixels pin the rotation and the zoom: sigma^2 (J^T W J)^-1, the weights
       // read as inverse variances (an approximation for the biweight's; calibrated by its user).
       const Normal inverse = normal.inv(cv::DECOMP_CHOLESKY);
       out.rotation_sigma = std::sqrt(std::max(inverse(0, 0) * (sigma * sigma), 0.0));
+      out.log_zoom_sigma = std::sqrt(std::max(inverse(1, 1) * (sigma * sigma), 0.0));
       if (fit_stretch) {
         const int index[3] = {0, 6, 7};  // rotation, stretch a, stretch b
         for (int a = 0; a < 3; ++a) {

@@ -172,6 +172,50 @@ TEST(ZoomRefinement, BrightnessChangeAndNoiseKeepTheZoom) {
   EXPECT_NEAR(std::log(refined.zoom) / per_bin, bins, 0.03);
 }
 
+TEST(ZoomRefinement, TheRefinedZoomsSigmaFollowsTheNoiseAndCoversItsError) {
+  // The surface's peak width is the same whatever the noise; the refinement's normal equations
+  // are not. The estimator takes the refined zoom with that sigma, calibrated
+  // (uncertainty.refined_log_zoom_scale).
+  const double per_bin = logZoomPerBin();
+  const double bins = 0.3;
+  const UncertaintyConfig uncertainty;
+  double sigma_clean = 0.0, sigma_noisy = 0.0;
+  int pairs = 0;
+  for (const double noise : {0.0, 1.0}) {
+    for (const unsigned seed : {7u, 8u, 9u}) {
+      test::ImagePair pair = test::warpedPair(motionOf(bins, 0.0, per_bin), kN, seed);
+      cv::Scalar mean, deviation;
+      cv::meanStdDev(pair.newer, mean, deviation);
+      cv::Mat1f grain(pair.newer.size());
+      cv::RNG rng(seed);
+      rng.fill(grain, cv::RNG::NORMAL, 0.0, noise * deviation[0]);
+      pair.newer = pair.newer + grain;
+      const PairRegistration r = registerWith(true, pair);
+      ASSERT_EQ(r.status, RegistrationStatus::kOk) << noise << " " << seed;
+      ASSERT_TRUE(r.zoom_refined) << noise << " " << seed;
+      ASSERT_GT(r.refined_log_zoom_sigma, 0.0) << noise << " " << seed;
+      const PairMotion m = detail::calibrated(r, uncertainty);
+      EXPECT_DOUBLE_EQ(m.log_zoom_sigma, r.refined_log_zoom_sigma * uncertainty.refined_log_zoom_scale);
+      const double error = std::fabs(std::log(r.zoom) - bins * per_bin);
+      if (noise > 0.0) {
+        // Three calibrated sigmas: a normal error lies within them all but once in 370.
+        EXPECT_LT(error, 3.0 * m.log_zoom_sigma) << seed;
+      } else {
+        // Without noise the images' interpolation is what is left, a hundredth of a bin, below
+        // what the normal equations see (rendered flights always carry some noise).
+        EXPECT_LT(error, 0.02 * per_bin) << seed;
+      }
+      (noise > 0.0 ? sigma_noisy : sigma_clean) += r.refined_log_zoom_sigma;
+      ++pairs;
+    }
+  }
+  EXPECT_EQ(pairs, 6);
+  // Noise as strong as the texture: the zoom is pinned less closely.
+  EXPECT_GT(sigma_noisy, 2.0 * sigma_clean);
+  // And far more closely than the surface's peak width says (about a per cent).
+  EXPECT_LT(sigma_noisy / 3.0 * uncertainty.refined_log_zoom_scale, 2e-3);
+}
+
 // A frame of weak texture (grey std 10 of 255 about mid grey) whose exposure changed: every grey
 // level, the mean too, 10 % brighter or darker.
 cv::Mat1f weakTexture(const cv::Mat1f& image, double gain) {

@@ -98,6 +98,9 @@ struct UncertaintyConfig {
   double direction_scale = 0.3;  ///< error across d / (shift * direction_sigma)
   /// theta error / the zoom refinement's rotation sigma (PairRegistration::refined_rotation_sigma)
   double refined_rotation_scale = 3.1;
+  /// ln s error / the zoom refinement's sigma (PairRegistration::refined_log_zoom_sigma), where
+  /// the zoom was refined
+  double refined_log_zoom_scale = 2.4;
 
   void validate() const;
 };

@@ -120,6 +120,11 @@ struct PairRegistration {
   /// weighs the two (doc/method.md).
   double refined_rotation = 0.0;
   double refined_rotation_sigma = 0.0;
+  /// Where the zoom was refined: the sigma of its ln(zoom) from the refinement's normal equations
+  /// (SimilarityRefinement::log_zoom_sigma; 0: none). The estimator takes it, calibrated, for the
+  /// zoom's: the surface's peak width (log_zoom_sigma) says how sharp its peak is, about the same
+  /// for every pair of a scene, not how far the refined zoom is from the truth.
+  double refined_log_zoom_sigma = 0.0;
   /// The refinement had not settled (its last step still moved the image's edge by more than a
   /// fiftieth of a pixel): it was heading for several layers' compromise, or along a valley of a
   /// striped texture. The blocks that follow the pair's shift (BlockMotionReader) read the

@@ -61,6 +61,8 @@ struct SimilarityRefinement {
   /// equations and the residuals' robust sigma (0: no step was solved). It describes the pixels'
   /// noise, not a model that does not fit (several depth layers): calibrate before use.
   double rotation_sigma = 0.0;
+  /// The same of ln(zoom).
+  double log_zoom_sigma = 0.0;
   /// Covariance of (rotation, stretch_a, stretch_b) from the same normal equations, for a reading
   /// that combines them (zero when no step was solved or the stretch was not fitted).
   cv::Matx33d rotation_stretch_covariance = cv::Matx33d::zeros();

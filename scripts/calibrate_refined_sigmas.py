@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Calibrates uncertainty.refined_rotation_scale: renders flights that are not in the
-generalization corpus (other seeds and scenes), runs oefmt_offline on each and compares both
-readings of every registered pair's rotation with the truth.
+"""Calibrates the sigmas of the zoom refinement's readings, uncertainty.refined_rotation_scale and
+uncertainty.refined_log_zoom_scale: renders flights that are not in the generalization corpus
+(other seeds and scenes), runs oefmt_offline on each and compares both readings of every
+registered pair's rotation, and every refined zoom, with the truth.
 
 The pair's rotation is the inverse-variance mean of the rotation surface's reading (sigma: its
 peak width times uncertainty.rotation_scale) and the zoom refinement's (sigma: its normal
@@ -17,16 +18,24 @@ their sigma times a factor that puts it in refinement sigmas (kBlockSigmaInRefin
 registration.cpp); the factor that gives the blocks' readings the same q90 as the refinement's is
 printed beside the scale: the shipped factor times q90(blocks) / q90(refinement).
 
-  scripts/calibrate_rotation_sigma.py [--tools build/devel/lib/oefmt] [--work build/calibration]
+The refined zoom stands alone (the surface's peak width is about the same for every pair of a
+scene and says nothing of it): its scale makes the refinement's sigma a standard deviation, with
+90 % of the errors within 1.645 sigmas as for a normal distribution:
+
+  refined_log_zoom_scale = q90(|refined zoom error| / refinement's zoom sigma) / 1.645
+
+  scripts/calibrate_refined_sigmas.py [--tools build/devel/lib/oefmt] [--work build/calibration]
 """
 import argparse
 import csv
+import math
 import os
 import sys
 
 import benchmark_common as common
 
-# Level circles with a fixed heading (the true rotation of every pair is zero), 80 frames each,
+# Level circles with a fixed heading (the true rotation and zoom of every pair are zero and one,
+# for every depth layer), 80 frames each,
 # scenes unlike one another: the default one, natural texture, walls, weak texture, low overlap,
 # brick.
 FLIGHTS = [
@@ -41,7 +50,9 @@ FRAMES = "80"
 # kBlockSigmaInRefinementSigmas in src/registration/registration.cpp, as shipped.
 BLOCK_SIGMA_FACTOR = 0.74
 ROTATION_SCALE_KEY = "rotation_scale:"
-CALLER = "calibrate_rotation_sigma"
+# |x| of a normal distribution lies within this many sigmas 90 % of the time.
+NORMAL_Q90 = 1.645
+CALLER = "calibrate_refined_sigmas"
 
 
 def quantile(values, q):
@@ -62,9 +73,12 @@ def ratios(tools, work, name, options, surface_scale):
     diagnostics = os.path.join(work, name + ".csv")
     common.run([os.path.join(tools, "oefmt_offline"), "--quiet", "--images", folder, "--mode", "oefmt",
                 "--output", os.path.join(work, name + ".tum"), "--diagnostics", diagnostics], CALLER)
-    surface, refined, blocks = [], [], []
+    surface, refined, blocks, zooms = [], [], [], []
     with open(diagnostics, newline="") as table:
         for row in csv.DictReader(table):
+            sigma_zoom = float(row["sigma_refined_log_zoom"])
+            if row["state"] == "tracking" and sigma_zoom > 0.0:
+                zooms.append(abs(math.log(float(row["zoom"]))) / sigma_zoom)
             sigma_refined = float(row["sigma_refined_theta_rad"])
             if row["state"] != "tracking" or not sigma_refined > 0.0:
                 continue
@@ -72,7 +86,7 @@ def ratios(tools, work, name, options, surface_scale):
             surface.append(abs(float(row["theta_rad"])) / (surface_scale * float(row["sigma_theta_rad"])))
             ratio = abs(float(row["refined_theta_rad"])) / sigma_refined
             (blocks if int(row["motion_blocks"]) > 0 else refined).append(ratio)
-    return surface, refined, blocks
+    return surface, refined, blocks, zooms
 
 
 def main():
@@ -83,16 +97,17 @@ def main():
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     surface_scale = rotation_scale(args.tools)
-    all_surface, all_refined, all_blocks = [], [], []
+    all_surface, all_refined, all_blocks, all_zooms = [], [], [], []
     for name, options in FLIGHTS:
-        surface, refined, blocks = ratios(args.tools, args.work, name, options, surface_scale)
+        surface, refined, blocks, zooms = ratios(args.tools, args.work, name, options, surface_scale)
+        all_zooms += zooms
         if not refined:
             print(f"{name:10s} no refined pair")
             continue
         blocks_q90 = f"{quantile(blocks, 0.9):.2f}" if blocks else "-"
         print(f"{name:10s} {len(surface):3d} pairs: 90 % of errors within {quantile(surface, 0.9):.2f} surface "
               f"sigmas, {quantile(refined, 0.9):.2f} refinement sigmas; {len(blocks)} read by blocks: "
-              f"{blocks_q90}")
+              f"{blocks_q90}; {len(zooms)} refined zooms: {quantile(zooms, 0.9) if zooms else 0:.2f}")
         all_surface += surface
         all_refined += refined
         all_blocks += blocks
@@ -105,6 +120,10 @@ def main():
         q_blocks = quantile(all_blocks, 0.9)
         print(f"blocks     {len(all_blocks):3d} pairs: {q_blocks:.2f} sigmas -> the blocks' sigma factor "
               f"{BLOCK_SIGMA_FACTOR * q_blocks / q_refined:.2f} (shipped {BLOCK_SIGMA_FACTOR})")
+    if all_zooms:
+        q_zooms = quantile(all_zooms, 0.9)
+        print(f"zoom       {len(all_zooms):3d} refined zooms: 90 % of errors within {q_zooms:.2f} refinement "
+              f"sigmas -> refined_log_zoom_scale {q_zooms / NORMAL_Q90:.1f}")
 
 
 if __name__ == "__main__":
