@@ -595,6 +595,18 @@ PairMotion Estimator::State::consistentRates(const PairMotion& step, double rate
     est.zoom_predicted = true;
     out.log_zoom = prior12->log_zoom;
     out.log_zoom_sigma = std::hypot(zoom_deviations.spread(), prior12->log_zoom_sigma);
+  } else if (est.registration12.zoom_refined && zoom_deviations.supported()) {
+    // A refined zoom's sigma is calibrated (uncertainty.refined_log_zoom_scale), and the rates'
+    // prediction is off by about the spread of the last readings' deviations from theirs (their
+    // own errors included: the prediction is, if anything, better): the step takes the
+    // inverse-variance mean of the two. A pair that pins its zoom closely keeps it; one over
+    // several layers, whose sigma is tenths of a per cent, leans on the climb rate the last
+    // steps agreed on, and the altitude does not take its error whole (doc/method.md).
+    const double predicted = zoom_deviations.spread();
+    const double measured = step.log_zoom_sigma;
+    const double weight = predicted * predicted / (predicted * predicted + measured * measured);
+    out.log_zoom = prior12->log_zoom + weight * (step.log_zoom - prior12->log_zoom);
+    out.log_zoom_sigma = predicted * measured / std::hypot(predicted, measured);
   }
   if (est.turn_predicted || est.zoom_predicted) est.degraded = true;
   return out;

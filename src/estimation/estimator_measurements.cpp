@@ -400,7 +400,7 @@ bool RateDeviations::beyondGate(double deviation) const {
   return deviations_.size() >= support_ && std::fabs(deviation) > gate_ * spread();
 }
 bool RateDeviations::withinGate(double deviation) const {
-  return deviations_.size() >= support_ && std::fabs(deviation) <= gate_ * spread();
+  return supported() && std::fabs(deviation) <= gate_ * spread();
 }
 bool RateDeviations::outlier(double deviation, bool may_change_rate) {
   if (!may_change_rate && beyondGate(deviation)) return true;

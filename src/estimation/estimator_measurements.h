@@ -72,6 +72,8 @@ class RateDeviations {
   bool beyondGate(double deviation) const;
   /// Whether enough deviations are remembered to judge one, and `deviation` lies within the gate.
   bool withinGate(double deviation) const;
+  /// Whether enough deviations are remembered to judge one.
+  bool supported() const { return deviations_.size() >= support_; }
   /// The remembered deviations' spread as a normal sigma (at least the floor).
   double spread() const;
   void clear();

@@ -91,6 +91,20 @@ sim::FlightOptions tiledFigureEight() {
   return options;
 }
 
+sim::FlightOptions roofLine(unsigned seed) {
+  sim::FlightOptions options;
+  options.track.shape = sim::TrackShape::kLine;
+  options.track.frames = 100;
+  options.track.length = 200.0;
+  options.track.altitude = 20.0;
+  options.track.heading = sim::HeadingMode::kTrack;
+  options.track.line_direction = 30.0 * M_PI / 180.0;
+  options.level_heights = {8.0};
+  options.walls = true;
+  options.seed = seed;
+  return options;
+}
+
 sim::FlightOptions weakTextureFlight(sim::TrackShape shape, unsigned seed) {
   sim::FlightOptions options;
   options.track.shape = shape;

@@ -63,6 +63,11 @@ sim::FlightOptions weakTextureFlight(sim::TrackShape shape, unsigned seed);
 /// walls in view, consecutive frames overlapping 78 % (seed 22).
 sim::FlightOptions tiledFigureEight();
 
+/// The generalization corpus's strong-parallax lines (`line-parallax-s2` is seed 34): a level
+/// 200 m line at 20 m over blocks whose tops stand at 8 m, walls in view, the heading on the
+/// track, 100 frames.
+sim::FlightOptions roofLine(unsigned seed);
+
 /// The simulator's plan for `options`, cut to its first `frames` frames.
 sim::FlightPlan plannedFlight(const sim::FlightOptions& options, int frames);
 

@@ -19,20 +19,9 @@ namespace {
 
 // A line over blocks whose tops stand at 40 % of the 20 m altitude, walls in view, the heading
 // on the track: at some frames the roofs fill most of the view and their texture leaves the
-// translation peak too flat to trust alone (the start of a generalization corpus flight).
-sim::FlightOptions roofLine() {
-  sim::FlightOptions options;
-  options.track.shape = sim::TrackShape::kLine;
-  options.track.frames = 100;  // the corpus flight, of which the test flies the first 56 frames
-  options.track.length = 200.0;
-  options.track.altitude = 20.0;
-  options.track.heading = sim::HeadingMode::kTrack;
-  options.track.line_direction = 30.0 * M_PI / 180.0;
-  options.level_heights = {8.0};
-  options.walls = true;
-  options.seed = 12;
-  return options;
-}
+// translation peak too flat to trust alone (the start of a generalization corpus flight, of
+// which the tests fly the first 56 frames).
+sim::FlightOptions roofLine() { return test::roofLine(12); }
 
 // The true step from frame k - 1 to k on the ground, in pixels.
 double groundStepPixels(const sim::FlightPlan& plan, std::size_t k) {

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A refined zoom carries a calibrated sigma; the step weighs it against the climb rate the last
+// steps agreed on. Over strong parallax with walls in view (the corpus's line-parallax-s2: a
+// level line, so every true zoom is one), some pairs read zooms tenths of a per cent off, with
+// sigmas to match: the steps must take less of their error, and keep the zooms of the pairs that
+// pin theirs closely.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <vector>
+
+#include "oefmt/estimation/estimator.h"
+#include "oefmt/sim/flight.h"
+#include "support/flight_fixtures.h"
+
+namespace oefmt {
+namespace {
+
+TEST(ZoomAgainstRates, AZoomReadOverSeveralLayersLeansOnTheRates) {
+  const sim::FlightOptions options = test::roofLine(34);
+  // The first 60 frames: the roofs and their walls come into view on the first ones.
+  const sim::FlightPlan plan = test::plannedFlight(options, 60);
+  const std::vector<cv::Mat1b> frames = test::renderPlan(plan);
+  Estimator estimator(test::simulatedFlightConfig(plan));
+  std::vector<double> sigmas;
+  struct Step {
+    double sigma, measured, taken;
+  };
+  std::vector<Step> steps;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const std::optional<Estimate> e = estimator.push(frames[k], plan.stamps[k]);
+    ASSERT_TRUE(e) << "frame " << k;
+    const PairRegistration& r = e->registration12;
+    if (e->state != TrackingState::kTracking || !r.zoom_refined || e->zoom_predicted) continue;
+    // Level flight: the true zoom is one, each reading's error its log.
+    steps.push_back({e->measured12.log_zoom_sigma, std::log(r.zoom), e->step.log_zoom});
+    sigmas.push_back(e->measured12.log_zoom_sigma);
+  }
+  ASSERT_GE(steps.size(), 40u) << "the premise: most pairs refined their zoom";
+  std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+  const double median_sigma = sigmas[sigmas.size() / 2];
+  double loose_measured = 0.0, loose_taken = 0.0, tight_change = 0.0, tight_error = 0.0;
+  int loose = 0, tight = 0;
+  for (const Step& s : steps) {
+    if (s.sigma > 5.0 * median_sigma) {
+      loose_measured += s.measured * s.measured;
+      loose_taken += s.taken * s.taken;
+      ++loose;
+    } else if (s.sigma <= median_sigma) {
+      tight_change += std::fabs(s.taken - s.measured);
+      tight_error += std::fabs(s.measured);
+      ++tight;
+    }
+  }
+  ASSERT_GE(loose, 4) << "the premise: pairs whose zoom the refinement pinned loosely";
+  const double rms_measured = 100.0 * std::sqrt(loose_measured / loose);
+  const double rms_taken = 100.0 * std::sqrt(loose_taken / loose);
+  std::printf("[ zoom vs rates ] %d loosely pinned zooms (sigma > 5 x the median %.4f %%): rms error %.3f %% "
+              "as read, %.3f %% as taken; %d closely pinned: moved by %.4f %% on average (error %.4f %%)\n",
+              loose, 100.0 * median_sigma, rms_measured, rms_taken, tight, 100.0 * tight_change / tight,
+              100.0 * tight_error / tight);
+  EXPECT_GT(rms_measured, 0.1) << "the premise: those zooms were read tenths of a per cent off";
+  EXPECT_LT(rms_taken, 0.5 * rms_measured) << "the steps took less than half of their error";
+  // A closely pinned zoom stays nearly as read.
+  EXPECT_LT(tight_change, 0.5 * tight_error + 1e-5 * tight);
+}
+
+}  // namespace
+}  // namespace oefmt
