@@ -254,12 +254,12 @@ LOCAL_SCALE_STEPS = 10
 
 def sigma_coverage(trajectory, diagnostics, truth, alignment):
     """Normalised step errors of a run: (heading, along-track, across-track, altitude) errors over
-    their reported sigmas, one entry per tracked step (None where a step did not move). A monocular estimate's scale is not observable
-    and drifts slowly, and its heading drifts too: a step's sigma describes the step against its
-    neighbours, while what came before it is the pose's covariance. So each step is scaled and
-    turned by the local scale and heading (the medians over LOCAL_SCALE_STEPS steps on each side
-    of the true to estimated step lengths and of the angles between them) instead of the whole
-    flight's."""
+    their reported sigmas, one entry per tracked step (None where a step did not move). A
+    monocular estimate's scale is not observable and drifts slowly, and its heading drifts too: a
+    step's sigma describes the step against its neighbours, while what came before it is the
+    pose's covariance. So each step is scaled and turned by the local scale and heading (the
+    medians over LOCAL_SCALE_STEPS steps on each side of the true to estimated step lengths and of
+    the angles between them) instead of the whole flight's."""
     est, gt = read_tum(trajectory), read_tum(truth)
     with open(diagnostics) as table:
         rows = list(csv.DictReader(table))

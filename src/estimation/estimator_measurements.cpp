@@ -397,7 +397,7 @@ RateDeviations::RateDeviations(std::size_t frames, std::size_t support, double g
     : frames_(frames), support_(std::min(support, frames)), gate_(gate), floor_(floor) {}
 
 bool RateDeviations::beyondGate(double deviation) const {
-  return deviations_.size() >= support_ && std::fabs(deviation) > gate_ * spread();
+  return supported() && std::fabs(deviation) > gate_ * spread();
 }
 bool RateDeviations::withinGate(double deviation) const {
   return supported() && std::fabs(deviation) <= gate_ * spread();

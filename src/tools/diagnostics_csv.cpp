@@ -78,7 +78,7 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
       {"sigma_refined_log_zoom", "",
        "sigma of the refined ln(zoom) from the refinement's normal equations (0: the zoom was not refined; "
        "uncertainty.refined_log_zoom_scale calibrates it)",
-       [](const Estimate& e) { return format("%.8f", pair12(e).zoom_refined ? pair12(e).refined_log_zoom_sigma : 0.0); }},
+       [](const Estimate& e) { return format("%.8f", pair12(e).refined_log_zoom_sigma); }},
       {"sigma_phi_rad", "rad", "sigma of phi_rad from the peak's width",
        [](const Estimate& e) { return format("%.8f", pair12(e).direction_sigma); }},
       {"sigma_rho_px", "px", "sigma of rho_px from the peak's width",
