@@ -19,10 +19,15 @@ registration.cpp); the factor that gives the blocks' readings the same q90 as th
 printed beside the scale: the shipped factor times q90(blocks) / q90(refinement).
 
 The refined zoom stands alone (the surface's peak width is about the same for every pair of a
-scene and says nothing of it): its scale makes the refinement's sigma a standard deviation, with
-90 % of the errors within 1.645 sigmas as for a normal distribution:
+scene and says nothing of it). Its sigma has two parts: the refinement's times the scale, and the
+part of the slope correction that was not taken (sigma_slope_log_zoom, in ln zoom already and
+not scaled). The scale is calibrated where it stands alone, on the zooms whose slope part is
+zero, to put 90 % of their errors within 1.645 sigmas as for a normal distribution:
 
   refined_log_zoom_scale = q90(|refined zoom error| / refinement's zoom sigma) / 1.645
+
+and the slope part is checked where it dominates (its q90 should be about 1.645 as well), as is
+the share of all zooms within 1.645 of their combined sigma (about 90 %).
 
   scripts/calibrate_refined_sigmas.py [--tools build/devel/lib/oefmt] [--work build/calibration]
 """
@@ -60,6 +65,25 @@ def quantile(values, q):
     return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
+def report_zoom_scale(zooms):
+    """Prints refined_log_zoom_scale from the zooms (error, refinement's sigma, slope sigma) whose
+    slope part is zero, and checks the slope part and the combined sigma on the others."""
+    alone = [error / refined for error, refined, slope in zooms if slope == 0.0]
+    if not alone:
+        print("zoom       no refined zoom without a slope part")
+        return
+    scale = quantile(alone, 0.9) / NORMAL_Q90
+    print(f"zoom       {len(alone):3d} refined zooms without a slope part: 90 % of errors within "
+          f"{quantile(alone, 0.9):.2f} refinement sigmas -> refined_log_zoom_scale {scale:.1f}")
+    sloped = [error / slope for error, refined, slope in zooms if slope > scale * refined]
+    if sloped:
+        print(f"slope      {len(sloped):3d} zooms whose slope part is the larger: 90 % of errors within "
+              f"{quantile(sloped, 0.9):.2f} slope sigmas ({NORMAL_Q90} for a calibrated sigma)")
+    within = sum(1 for error, refined, slope in zooms if error <= NORMAL_Q90 * math.hypot(scale * refined, slope))
+    print(f"combined   {len(zooms):3d} refined zooms: {100.0 * within / len(zooms):.0f} % of errors within "
+          f"{NORMAL_Q90} combined sigmas (90 % for a calibrated sigma)")
+
+
 def rotation_scale(tools):
     """uncertainty.rotation_scale as shipped (oefmt_parameters --yaml)."""
     for line in common.run([os.path.join(tools, "oefmt_parameters"), "--yaml"], CALLER).splitlines():
@@ -78,7 +102,7 @@ def ratios(tools, work, name, options, surface_scale):
         for row in csv.DictReader(table):
             sigma_zoom = float(row["sigma_refined_log_zoom"])
             if row["state"] == "tracking" and sigma_zoom > 0.0:
-                zooms.append(abs(math.log(float(row["zoom"]))) / sigma_zoom)
+                zooms.append((abs(math.log(float(row["zoom"]))), sigma_zoom, float(row["sigma_slope_log_zoom"])))
             sigma_refined = float(row["sigma_refined_theta_rad"])
             if row["state"] != "tracking" or not sigma_refined > 0.0:
                 continue
@@ -107,7 +131,8 @@ def main():
         blocks_q90 = f"{quantile(blocks, 0.9):.2f}" if blocks else "-"
         print(f"{name:10s} {len(surface):3d} pairs: 90 % of errors within {quantile(surface, 0.9):.2f} surface "
               f"sigmas, {quantile(refined, 0.9):.2f} refinement sigmas; {len(blocks)} read by blocks: "
-              f"{blocks_q90}; {len(zooms)} refined zooms: {quantile(zooms, 0.9) if zooms else 0:.2f}")
+              f"{blocks_q90}; {len(zooms)} refined zooms: "
+              f"{quantile([e / r for e, r, _ in zooms], 0.9) if zooms else 0:.2f}")
         all_surface += surface
         all_refined += refined
         all_blocks += blocks
@@ -121,9 +146,7 @@ def main():
         print(f"blocks     {len(all_blocks):3d} pairs: {q_blocks:.2f} sigmas -> the blocks' sigma factor "
               f"{BLOCK_SIGMA_FACTOR * q_blocks / q_refined:.2f} (shipped {BLOCK_SIGMA_FACTOR})")
     if all_zooms:
-        q_zooms = quantile(all_zooms, 0.9)
-        print(f"zoom       {len(all_zooms):3d} refined zooms: 90 % of errors within {q_zooms:.2f} refinement "
-              f"sigmas -> refined_log_zoom_scale {q_zooms / NORMAL_Q90:.1f}")
+        report_zoom_scale(all_zooms)
 
 
 if __name__ == "__main__":

@@ -204,7 +204,7 @@ ParameterTable estimatorParameters(EstimatorConfig& c) {
       numberParameter("uncertainty.refined_log_zoom_scale", u.refined_log_zoom_scale, "",
                       closedRange(1e-4, 100.0),
                       "log-zoom error per sigma of the zoom refinement's log-zoom (from its normal "
-                      "equations), the sigma of a refined zoom"),
+                      "equations); with the slope correction that was not taken, the sigma of a refined zoom"),
 
       integerParameter("efmt.zoom_samples", e.zoom_samples, "", closedRange(1, 50),
                        "zoom hypotheses sampled between the least and the most significant zoom"),

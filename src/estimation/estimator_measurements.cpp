@@ -279,8 +279,10 @@ PairMotion calibrated(const PairRegistration& r, const UncertaintyConfig& u) {
   if (!predicted && r.zoom_refined && r.refined_log_zoom_sigma > 0.0) {
     // The refined zoom's own sigma: the surface's peak width is the same for every pair of a
     // scene (about 1 %), while the refined zooms of the corpus erred 0.02 % to 0.3 %, as the
-    // refinement's normal equations say (doc/method.md).
-    m.log_zoom_sigma = std::max(r.refined_log_zoom_sigma * u.refined_log_zoom_scale, kMinLogZoomSigma);
+    // refinement's normal equations say, and as far again as the slope correction that was not
+    // taken where a slope or the layers stretch the view (doc/method.md).
+    m.log_zoom_sigma = std::max(std::hypot(r.refined_log_zoom_sigma * u.refined_log_zoom_scale, r.slope_log_zoom_sigma),
+                                kMinLogZoomSigma);
   }
   if (!predicted && r.zoom_refined && r.refined_rotation_sigma > 0.0 && std::isfinite(r.refined_rotation)) {
     // Two readings of the rotation: the surface's peak, whose fraction of a bin leans towards

@@ -140,9 +140,10 @@ namespace {
 // The slope correction of a level camera's zoom (logZoomOfSlope), taken only as far as it brings
 // the zoom back towards what the motion so far predicts: a slope under the motion explains a
 // zoom that broke away from the prediction. Where a stretch would move the zoom away from it,
-// or past it, the stretch is not a slope's (occlusions at walls, a mixture of layers that the
+// or past it, it is not taken as a slope's (occlusions at walls, a mixture of layers that the
 // affine model does not describe, noise): over strong parallax the pairs' zoom errors do not
-// follow their stretch. Without a prediction nothing is corrected.
+// follow their stretch. Without a prediction nothing is corrected. The part not taken may still
+// be a slope's: it is the zoom's uncertainty (PairRegistration::slope_log_zoom_sigma).
 double slopeTowardsPrediction(double correction, double to_prediction) {
   if (!(correction * to_prediction > 0.0)) return 0.0;
   return correction > 0.0 ? std::min(correction, to_prediction) : std::max(correction, to_prediction);
@@ -187,10 +188,13 @@ void refineZoom(const FrameSpectra& older, const FrameSpectra& newer, const Spec
   // tracked over many pairs); a level camera's, the slope of the surface under this pair.
   if (plane_tilt) {
     result.tilt_log_zoom = logZoomOfTilt(*plane_tilt, refined.similarity.translation);
-  } else if (prior != nullptr) {
-    result.tilt_log_zoom = slopeTowardsPrediction(
-        logZoomOfSlope(refined.similarity.stretch_a, refined.similarity.stretch_b, refined.similarity.translation),
-        prior->log_zoom - refined.similarity.log_zoom);
+  } else {
+    const double slope =
+        logZoomOfSlope(refined.similarity.stretch_a, refined.similarity.stretch_b, refined.similarity.translation);
+    if (prior != nullptr) {
+      result.tilt_log_zoom = slopeTowardsPrediction(slope, prior->log_zoom - refined.similarity.log_zoom);
+    }
+    result.slope_log_zoom_sigma = std::fabs(slope - result.tilt_log_zoom);
   }
   result.zoom = std::exp(refined.similarity.log_zoom + result.tilt_log_zoom);
   result.zoom_refined = true;

@@ -79,6 +79,10 @@ const std::vector<DiagnosticsColumn>& diagnosticsColumns() {
        "sigma of the refined ln(zoom) from the refinement's normal equations (0: the zoom was not refined; "
        "uncertainty.refined_log_zoom_scale calibrates it)",
        [](const Estimate& e) { return format("%.8f", pair12(e).refined_log_zoom_sigma); }},
+      {"sigma_slope_log_zoom", "",
+       "the part of the slope's ln(zoom) that pair 1-2's stretch read and its zoom does not hold, added to the "
+       "refined zoom's sigma (0: the whole correction was taken, or none was read)",
+       [](const Estimate& e) { return format("%.8f", pair12(e).slope_log_zoom_sigma); }},
       {"sigma_phi_rad", "rad", "sigma of phi_rad from the peak's width",
        [](const Estimate& e) { return format("%.8f", pair12(e).direction_sigma); }},
       {"sigma_rho_px", "px", "sigma of rho_px from the peak's width",

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "estimation/estimator_measurements.h"
 #include "oefmt/estimation/estimator.h"
 #include "oefmt/estimation/plane_tilt_tracker.h"
 #include "oefmt/registration/plane_tilt.h"
@@ -181,6 +182,8 @@ TEST(PlaneTilt, TheSlopeCorrectionIsMinusTheStretchAlongTheMotion) {
 // not. The pair's read zoom holds half the slope's rise (about 0.6 % here). With the motion so far
 // predicting no climb, the stretch along the motion takes it out; a prediction on the other side
 // of the read zoom, or none, leaves the zoom as read, and one short of the truth stops it there.
+// What the correction did not take is the zoom's uncertainty: the zoom's calibrated sigma then
+// covers the error the slope left in it.
 TEST(PlaneTilt, ALevelFlightOverASlopeReadsNoClimb) {
   FlatPairRig rig(5);
   const sim::FlightPlan& plan = rig.plan;
@@ -216,19 +219,28 @@ TEST(PlaneTilt, ALevelFlightOverASlopeReadsNoClimb) {
   const double slope = std::tan(std::hypot(3.0, 1.5) * kDeg) / plan.camera.intrinsics.fx;
   EXPECT_NEAR(cv::norm(tilt), slope, 0.1 * slope);
 
+  // Nothing was taken: the whole slope reading, which would have undone the read zoom.
+  EXPECT_NEAR(unpredicted.slope_log_zoom_sigma, std::fabs(read), 0.0012);
+  const UncertaintyConfig uncertainty;
+  EXPECT_GT(detail::calibrated(unpredicted, uncertainty).log_zoom_sigma, std::fabs(read));
+
   const PairRegistration predicted = registered(0.0);
   ASSERT_TRUE(predicted.zoom_refined);
   EXPECT_NEAR(std::log(predicted.zoom), 0.0, 0.0012);
   EXPECT_GT(std::fabs(predicted.tilt_log_zoom), 0.004);
+  EXPECT_LT(predicted.slope_log_zoom_sigma, 0.0012);
 
   const PairRegistration beyond = registered(2.0 * read);  // the prediction on the read zoom's side
   ASSERT_TRUE(beyond.zoom_refined);
   EXPECT_EQ(beyond.tilt_log_zoom, 0.0);
   EXPECT_DOUBLE_EQ(beyond.zoom, unpredicted.zoom);
+  EXPECT_DOUBLE_EQ(beyond.slope_log_zoom_sigma, unpredicted.slope_log_zoom_sigma);
 
   const PairRegistration short_of_truth = registered(0.5 * read);
   ASSERT_TRUE(short_of_truth.zoom_refined);
   EXPECT_NEAR(std::log(short_of_truth.zoom), 0.5 * read, 1e-12);
+  EXPECT_NEAR(short_of_truth.slope_log_zoom_sigma, 0.5 * std::fabs(read), 0.0012);
+  EXPECT_GT(detail::calibrated(short_of_truth, uncertainty).log_zoom_sigma, 0.5 * std::fabs(read));
 }
 
 // A straight flight over flat ground whose levelled views are off by 1.5 degrees throughout (an

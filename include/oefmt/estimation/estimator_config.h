@@ -99,8 +99,9 @@ struct UncertaintyConfig {
   /// theta error / the zoom refinement's rotation sigma (PairRegistration::refined_rotation_sigma)
   double refined_rotation_scale = 3.1;
   /// ln s error / the zoom refinement's sigma (PairRegistration::refined_log_zoom_sigma), where
-  /// the zoom was refined
-  double refined_log_zoom_scale = 2.4;
+  /// the zoom was refined; the slope correction not taken adds to it unscaled
+  /// (PairRegistration::slope_log_zoom_sigma)
+  double refined_log_zoom_scale = 1.8;
 
   void validate() const;
 };

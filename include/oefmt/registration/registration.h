@@ -136,6 +136,12 @@ struct PairRegistration {
   /// ln(zoom) added for the ground plane's tilt or the followed surface's slope
   /// (Registrar::setPlaneTilt), included in `zoom`.
   double tilt_log_zoom = 0.0;
+  /// A level camera's refined pair: the part of the slope's ln(zoom) that the fitted stretch
+  /// reads (logZoomOfSlope) and `zoom` does not hold, as a sigma [ln s]. The stretch is a sloping
+  /// surface's, and the zoom is then off by it, or a mixture of depth layers', and then it is not:
+  /// the pair cannot tell which. 0 where the whole correction was taken, for a levelled view, or
+  /// where the zoom was not refined.
+  double slope_log_zoom_sigma = 0.0;
   /// The older frame was warped before the translation correlation (false: the rotation/zoom
   /// moved no pixel by more than identity_warp_px and its cached spectrum served).
   bool warped = true;
